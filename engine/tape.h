@@ -1,0 +1,144 @@
+// The tape: reverse-mode automatic differentiation over blocks.
+//
+// Every op appends one node (its value, an N x C block) in creation order and,
+// if any input needs a gradient, a closure that pulls the node's gradient back
+// into its inputs' gradients. backward() seeds d(loss)/d(loss) = 1 and walks the
+// nodes in reverse: a plain loop, no recursion, because creation order is already
+// a topological order. Gradients accumulate (+=), so a block used twice gets the
+// sum of both paths.
+//
+// Memory: clear() forgets the graph but keeps every node's storage. The next
+// iteration builds the same graph with the same shapes, so Eigen's resize() is a
+// no-op and nothing is reallocated after the first step.
+//
+// There is no global tape: every op takes the tape it writes to.
+#pragma once
+#include <functional>
+#include <initializer_list>
+#include <vector>
+
+#include "engine/block.h"
+#include "engine/check.h"
+
+namespace jsa {
+
+// A handle to a node: its position on the tape.
+struct Var {
+  int id = -1;
+  bool valid() const { return id >= 0; }
+};
+
+template <class T>
+class Tape {
+ public:
+  using Scalar = T;
+  // Pull-back of one node: reads grad(self) and adds into its inputs' grads.
+  using Backward = std::function<void(Tape&, Var self)>;
+
+  // A block that needs no gradient (data, targets, constants).
+  Var constant(const Block<T>& value) { return leaf_impl(value, false); }
+  // A block whose gradient the caller wants to read after backward().
+  Var variable(const Block<T>& value) { return leaf_impl(value, true); }
+
+  // The custom-op hook. Appends a node of shape rows x cols whose value the
+  // caller fills (value(out) = ...), then registers its pull-back with
+  // on_backward(). needs_grad is true iff some input needs a gradient.
+  Var node(Index rows, Index cols, std::initializer_list<Var> inputs) {
+    bool ng = false;
+    for (Var v : inputs) ng = ng || needs_grad(v);
+    return alloc(rows, cols, ng);
+  }
+  Var node(Index rows, Index cols, const std::vector<Var>& inputs) {
+    bool ng = false;
+    for (Var v : inputs) ng = ng || needs_grad(v);
+    return alloc(rows, cols, ng);
+  }
+  // Registers the pull-back of `out`; skipped when nothing upstream needs it.
+  void on_backward(Var out, Backward f) {
+    if (nodes_[out.id].needs_grad) nodes_[out.id].backward = std::move(f);
+  }
+
+  const Block<T>& value(Var v) const { return nodes_[check(v)].value; }
+  Block<T>& value(Var v) { return nodes_[check(v)].value; }
+  Block<T>& grad(Var v) { return nodes_[check(v)].grad; }
+  const Block<T>& grad(Var v) const { return nodes_[check(v)].grad; }
+  bool needs_grad(Var v) const { return nodes_[check(v)].needs_grad; }
+  Index rows(Var v) const { return value(v).rows(); }
+  Index cols(Var v) const { return value(v).cols(); }
+  T scalar(Var v) const {
+    JSA_CHECK(rows(v) == 1 && cols(v) == 1, "not a scalar: " << rows(v) << "x" << cols(v));
+    return value(v)(0, 0);
+  }
+
+  // Reverse accumulation from a 1 x 1 node: zero every gradient that will be
+  // written, seed dloss = 1, then run the pull-backs newest first.
+  void backward(Var loss) {
+    JSA_CHECK(rows(loss) == 1 && cols(loss) == 1, "backward() needs a scalar loss");
+    for (int i = 0; i < size_; ++i) {
+      Node& n = nodes_[i];
+      if (n.needs_grad) n.grad.setZero(n.value.rows(), n.value.cols());
+    }
+    if (!needs_grad(loss)) return;
+    grad(loss)(0, 0) = T(1);
+    for (int i = loss.id; i >= 0; --i) {
+      Node& n = nodes_[i];
+      if (n.needs_grad && n.backward) n.backward(*this, Var{i});
+    }
+  }
+
+  // Index arrays an op needs in its pull-back (gathers, nearest-neighbour
+  // matches) live on the tape too, so they are reused like the blocks.
+  int keep(const std::vector<int>& index) {
+    if (kept_size_ == int(kept_.size())) kept_.emplace_back();
+    kept_[kept_size_].assign(index.begin(), index.end());
+    return kept_size_++;
+  }
+  const std::vector<int>& kept(int slot) const { return kept_[slot]; }
+
+  // Forgets the graph, keeps the storage (see the header comment).
+  void clear() {
+    for (int i = 0; i < size_; ++i) nodes_[i].backward = nullptr;
+    size_ = 0;
+    kept_size_ = 0;
+  }
+  int size() const { return size_; }
+  // Bytes held by node values and gradients (for memory reports).
+  size_t bytes() const {
+    size_t b = 0;
+    for (const Node& n : nodes_)
+      b += sizeof(T) * size_t(n.value.size() + n.grad.size());
+    return b;
+  }
+
+ private:
+  struct Node {
+    Block<T> value, grad;
+    Backward backward;
+    bool needs_grad = false;
+  };
+
+  int check(Var v) const {
+    JSA_CHECK(v.id >= 0 && v.id < size_, "stale or invalid Var " << v.id);
+    return v.id;
+  }
+  Var alloc(Index rows, Index cols, bool needs_grad) {
+    if (size_ == int(nodes_.size())) nodes_.emplace_back();
+    Node& n = nodes_[size_];
+    n.value.resize(rows, cols);
+    n.needs_grad = needs_grad;
+    n.backward = nullptr;
+    return Var{size_++};
+  }
+  Var leaf_impl(const Block<T>& value, bool needs_grad) {
+    Var v = alloc(value.rows(), value.cols(), needs_grad);
+    nodes_[v.id].value = value;
+    return v;
+  }
+
+  std::vector<Node> nodes_;
+  int size_ = 0;
+  std::vector<std::vector<int>> kept_;
+  int kept_size_ = 0;
+};
+
+}  // namespace jsa

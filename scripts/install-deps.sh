@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Installs exactly what jsatlas needs from Debian 12 packages. Idempotent.
+set -euo pipefail
+pkgs=(cmake g++ make pkg-config libeigen3-dev libnanoflann-dev libtinyobjloader-dev catch2
+      libcli11-dev nlohmann-json3-dev libstb-dev)
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#pkgs[@]} packages present"
+  exit 0
+fi
+sudo=""
+[ "$(id -u)" -ne 0 ] && sudo="sudo"
+echo "install-deps: installing ${missing[*]}"
+$sudo apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${missing[@]}"
