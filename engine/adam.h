@@ -27,6 +27,8 @@ class Adam {
   // State, for checkpoints.
   std::vector<T>& first_moment() { return m_; }
   std::vector<T>& second_moment() { return v_; }
+  const std::vector<T>& first_moment() const { return m_; }
+  const std::vector<T>& second_moment() const { return v_; }
   void set_steps(int64_t t) { t_ = t; }
   const AdamOptions& options() const { return options_; }
 
