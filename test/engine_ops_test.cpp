@@ -1,0 +1,257 @@
+// Tests of engine/ops_*.cpp: every op's pull-back against central finite
+// differences (engine/gradcheck.h, double precision), gradient accumulation when
+// one block feeds several ops, and the forward values of a few ops by hand.
+//
+// Tolerances: check_gradients' defaults, rtol 1e-5 and atol 1e-8 per entry
+// (|analytic - numeric| <= atol + rtol max(|analytic|, |numeric|)), relative
+// step 1e-6. Central differences on these smooth, O(1) graphs are accurate to
+// ~1e-9, so the margin is wide.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "engine/ops.h"
+#include "engine/tangents.h"
+#include "test/engine_gradcheck_cases.h"
+
+namespace jsa::test {
+
+std::vector<GradCase> op_cases() {
+  // N x C = 5 x 4 unless stated. Inputs that reach relu / sqrt / a norm come from
+  // signed_block (|x| >= 0.2) or are positive: no ReLU kink and no sqrt(0) lies
+  // within a finite-difference step of them, on purpose.
+  Rng rng(2024);
+  const Index n = 5, c = 4;
+  std::vector<GradCase> cases;
+  auto add_case = [&](std::string op, GraphBuilder f, std::vector<Block<double>> inputs) {
+    cases.push_back({std::move(op), std::move(f), std::move(inputs)});
+  };
+  using T = Tape<double>;
+  using Vs = std::vector<Var>;
+
+  // ---- linear ----
+  add_case("linear (bias)", [](T& t, const Vs& x) { return linear(t, x[0], x[1], x[2]); },
+           {signed_block(rng, n, 3), signed_block(rng, 3, c), signed_block(rng, 1, c)});
+  add_case("linear (no bias)", [](T& t, const Vs& x) { return linear(t, x[0], x[1], Var{}); },
+           {signed_block(rng, n, 3), signed_block(rng, 3, c)});
+  // 3N rows, the bias on the first N (the stacked-tangent convention).
+  add_case("linear (bias_rows = N of 3N)",
+           [n](T& t, const Vs& x) { return linear(t, x[0], x[1], x[2], n); },
+           {signed_block(rng, 3 * n, 3), signed_block(rng, 3, c), signed_block(rng, 1, c)});
+  add_case("relu", [](T& t, const Vs& x) { return relu(t, x[0]); }, {signed_block(rng, n, c)});
+  // Value rows away from 0 (the mask); the tangent rows may be anything.
+  add_case("relu_masked", [n](T& t, const Vs& x) { return relu_masked(t, x[0], n); },
+           {signed_block(rng, 3 * n, c)});
+
+  // ---- elementwise, all four broadcast shapes of b ----
+  struct Shape {
+    const char* name;
+    Index rows, cols;
+  };
+  const Shape shapes[] = {{"same", n, c}, {"1xC", 1, c}, {"Nx1", n, 1}, {"1x1", 1, 1}};
+  for (const Shape& s : shapes) {
+    add_case(std::string("add ") + s.name, [](T& t, const Vs& x) { return add(t, x[0], x[1]); },
+             {signed_block(rng, n, c), signed_block(rng, s.rows, s.cols)});
+    add_case(std::string("sub ") + s.name, [](T& t, const Vs& x) { return sub(t, x[0], x[1]); },
+             {signed_block(rng, n, c), signed_block(rng, s.rows, s.cols)});
+    add_case(std::string("mul ") + s.name, [](T& t, const Vs& x) { return mul(t, x[0], x[1]); },
+             {signed_block(rng, n, c), signed_block(rng, s.rows, s.cols)});
+  }
+  add_case("scale", [](T& t, const Vs& x) { return scale(t, x[0], -2.5); }, {signed_block(rng, n, c)});
+  add_case("offset", [](T& t, const Vs& x) { return offset(t, x[0], 0.7); }, {signed_block(rng, n, c)});
+  add_case("square", [](T& t, const Vs& x) { return square(t, x[0]); }, {signed_block(rng, n, c)});
+  // x in [0.5, 2): far from sqrt's singular derivative at 0.
+  add_case("sqrt", [](T& t, const Vs& x) { return sqrt(t, x[0]); }, {uniform_block(rng, n, c, 0.5, 2.0)});
+  add_case("exp", [](T& t, const Vs& x) { return exp(t, x[0]); }, {signed_block(rng, n, c)});
+
+  // ---- rows and columns ----
+  add_case("concat_cols", [](T& t, const Vs& x) { return concat_cols(t, x); },
+           {signed_block(rng, n, 2), signed_block(rng, n, 3), signed_block(rng, n, 1)});
+  add_case("slice_cols", [](T& t, const Vs& x) { return slice_cols(t, x[0], 1, 2); },
+           {signed_block(rng, n, c)});
+  add_case("concat_rows", [](T& t, const Vs& x) { return concat_rows(t, x); },
+           {signed_block(rng, 2, c), signed_block(rng, 4, c), signed_block(rng, 1, c)});
+  add_case("slice_rows", [](T& t, const Vs& x) { return slice_rows(t, x[0], 1, 3); },
+           {signed_block(rng, n, c)});
+  // Row 2 is gathered three times and row 3 never: the pull-back must add three
+  // gradients into row 2 and leave row 3 at zero.
+  add_case("gather_rows (repeats)",
+           [](T& t, const Vs& x) { return gather_rows(t, x[0], {2, 0, 2, 4, 2, 1}); },
+           {signed_block(rng, n, c)});
+
+  // ---- reductions and per-row geometry ----
+  add_case("sum", [](T& t, const Vs& x) { return sum(t, x[0]); }, {signed_block(rng, n, c)});
+  add_case("mean", [](T& t, const Vs& x) { return mean(t, x[0]); }, {signed_block(rng, n, c)});
+  add_case("row_sum", [](T& t, const Vs& x) { return row_sum(t, x[0]); }, {signed_block(rng, n, c)});
+  add_case("row_dot", [](T& t, const Vs& x) { return row_dot(t, x[0], x[1]); },
+           {signed_block(rng, n, c), signed_block(rng, n, c)});
+  // Rows with every |x_ij| >= 0.2 have norm >= 0.4: far from the kink at 0.
+  add_case("row_norm", [](T& t, const Vs& x) { return row_norm(t, x[0]); }, {signed_block(rng, n, c)});
+  add_case("row_normalize", [](T& t, const Vs& x) { return row_normalize(t, x[0]); },
+           {signed_block(rng, n, 3)});
+  add_case("cross3", [](T& t, const Vs& x) { return cross3(t, x[0], x[1]); },
+           {signed_block(rng, n, 3), signed_block(rng, n, 3)});
+  add_case("stack_tangents", [](T& t, const Vs& x) { return stack_tangents(t, x[0]); },
+           {signed_block(rng, n, 3)});
+  return cases;
+}
+
+// One line: the op, its worst relative error, entries checked, pass/fail.
+std::string table_line(const std::string& op, const GradCheckResult& r) {
+  std::ostringstream s;
+  s << "  " << std::left << std::setw(40) << op << std::right << std::setw(12) << std::scientific
+    << std::setprecision(2) << r.worst_relative << std::setw(9) << r.checked << "   "
+    << (r.ok ? "pass" : "FAIL");
+  return s.str();
+}
+
+TEST_CASE("every op passes check_gradients", "[ops][gradcheck]") {
+  for (const GradCase& g : op_cases()) {
+    DYNAMIC_SECTION(g.op) {
+      const GradCheckResult r = check_gradients(g.f, g.inputs, g.options);
+      INFO(table_line(g.op, r));
+      INFO(r.report);
+      CHECK(r.checked > 0);
+      CHECK(r.ok);
+    }
+  }
+}
+
+// The table the closing note quotes: every op, then the Jacobian losses.
+TEST_CASE("gradient check table", "[ops][gradcheck][table]") {
+  std::vector<GradCase> cases = op_cases();
+  for (GradCase& g : jacobian_cases()) cases.push_back(std::move(g));
+  std::ostringstream table;
+  table << "\n  gradient check (double, central differences, rel. step 1e-6)\n"
+        << "  op                                        worst rel.  entries   result\n";
+  bool all_ok = true;
+  for (const GradCase& g : cases) {
+    const GradCheckResult r = check_gradients(g.f, g.inputs, g.options);
+    table << table_line(g.op, r) << "\n";
+    if (!r.ok) table << r.report;
+    all_ok = all_ok && r.ok;
+  }
+  std::cout << table.str() << std::endl;
+  INFO(table.str());
+  CHECK(all_ok);
+}
+
+// ---- accumulation: a block used more than once gets the sum of all paths ----
+
+TEST_CASE("a block used twice accumulates both gradients", "[ops][accumulation]") {
+  Rng rng(5);
+  const Block<double> x0 = signed_block(rng, 4, 3);
+
+  SECTION("mul(x, x) + add(x, x): d/dx sum = 2x + 2, exactly") {
+    Tape<double> t;
+    Var x = t.variable(x0);
+    Var loss = sum(t, add(t, mul(t, x, x), add(t, x, x)));
+    t.backward(loss);
+    const Block<double> expected = (2.0 * x0.array() + 2.0).matrix();
+    CHECK((t.grad(x) - expected).cwiseAbs().maxCoeff() < 1e-15);
+  }
+  SECTION("the same, and row_dot(x, x), linear(x, W) twice, through check_gradients") {
+    const Block<double> w0 = signed_block(rng, 3, 3);
+    auto f = [](Tape<double>& t, const std::vector<Var>& v) {
+      Var x = v[0], w = v[1];
+      Var a = add(t, mul(t, x, x), add(t, x, x));
+      Var b = mul(t, x, row_dot(t, x, x));  // N x 1 broadcast over columns
+      Var c = linear(t, linear(t, x, w, Var{}), w, Var{});
+      return add(t, add(t, a, b), c);
+    };
+    const GradCheckResult r = check_gradients(f, {x0, w0});
+    INFO(r.report);
+    CHECK(r.ok);
+  }
+  SECTION("a constant input gets no gradient and costs no pull-back") {
+    Tape<double> t;
+    Var x = t.variable(x0);
+    Var k = t.constant(x0);
+    Var y = mul(t, k, k);
+    CHECK_FALSE(t.needs_grad(y));
+    Var loss = sum(t, mul(t, x, y));
+    t.backward(loss);
+    CHECK((t.grad(x) - x0.cwiseProduct(x0)).cwiseAbs().maxCoeff() < 1e-15);
+  }
+}
+
+// ---- forward values, by hand ----
+
+TEST_CASE("forward values of a few ops", "[ops][forward]") {
+  Tape<double> t;
+  Block<double> a(2, 3), w(3, 2), b(1, 2);
+  a << 1, -2, 3,  //
+      -1, 0.5, 2;
+  w << 1, 0,  //
+      0, 1,   //
+      1, 1;
+  b << 10, 20;
+  Var va = t.constant(a), vw = t.constant(w), vb = t.constant(b);
+
+  Block<double> y = t.value(linear(t, va, vw, vb));
+  Block<double> expect(2, 2);
+  expect << 14, 21,  //
+      11, 22.5;
+  CHECK(y.isApprox(expect));
+  // bias on the first row only
+  Block<double> y1 = t.value(linear(t, va, vw, vb, 1));
+  expect.row(1) << 1, 2.5;
+  CHECK(y1.isApprox(expect));
+
+  // relu_masked: mask from row block 0 applies to block 1.
+  Block<double> s(4, 2);
+  s << 1, -1,  //
+      -2, 3,   //
+      5, 6,    //
+      7, 8;
+  Block<double> m = t.value(relu_masked(t, t.constant(s), 2));
+  Block<double> mexp(4, 2);
+  mexp << 1, 0,  //
+      0, 3,      //
+      5, 0,      //
+      0, 8;
+  CHECK(m == mexp);
+
+  Block<double> p(1, 3), q(1, 3);
+  p << 1, 0, 0;
+  q << 0, 1, 0;
+  Block<double> z = t.value(cross3(t, t.constant(p), t.constant(q)));
+  CHECK(z(0, 0) == 0);
+  CHECK(z(0, 1) == 0);
+  CHECK(z(0, 2) == 1);
+
+  Block<double> r(1, 2);
+  r << 3, 4;
+  CHECK(t.value(row_norm(t, t.constant(r), 0.0))(0, 0) == Approx(5.0));
+  Block<double> rn = t.value(row_normalize(t, t.constant(r), 0.0));
+  CHECK(rn(0, 0) == Approx(0.6));
+  CHECK(rn(0, 1) == Approx(0.8));
+  CHECK(t.value(mean(t, t.constant(a)))(0, 0) == Approx(3.5 / 6));
+
+  // Gather with repeats and broadcasting shapes.
+  Block<double> g = t.value(gather_rows(t, t.constant(a), {1, 1, 0}));
+  CHECK(g.row(0) == a.row(1));
+  CHECK(g.row(1) == a.row(1));
+  CHECK(g.row(2) == a.row(0));
+  Block<double> col(2, 1);
+  col << 2, -1;
+  Block<double> mc = t.value(mul(t, va, t.constant(col)));
+  CHECK(mc.row(0) == 2 * a.row(0));
+  CHECK(mc.row(1) == -a.row(1));
+}
+
+TEST_CASE("shape errors are programmer errors", "[ops][errors]") {
+  Tape<double> t;
+  Var a = t.constant(Block<double>::Ones(3, 4));
+  CHECK_THROWS_AS(add(t, a, t.constant(Block<double>::Ones(2, 4))), InternalError);
+  CHECK_THROWS_AS(linear(t, a, t.constant(Block<double>::Ones(3, 2)), Var{}), InternalError);
+  CHECK_THROWS_AS(relu_masked(t, a, 2), InternalError);
+  CHECK_THROWS_AS(slice_cols(t, a, 2, 3), InternalError);
+  CHECK_THROWS_AS(gather_rows(t, a, {0, 3}), InternalError);
+  CHECK_THROWS_AS(cross3(t, a, a), InternalError);
+}
+
+}  // namespace jsa::test
