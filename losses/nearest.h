@@ -1,0 +1,30 @@
+// Exact nearest neighbours: for every query row, the index of the closest row of
+// `points` (squared Euclidean distance, any number of columns). The Chamfer terms
+// (Eqs. 6-8) and the evaluation metrics stand on this. A kd-tree (nanoflann)
+// does the work; it stays inside nearest.cpp so nothing else sees its templates.
+//
+// Ties: among points at exactly the same distance the lowest index wins, in both
+// the kd-tree and the brute-force oracle, so the two return the same indices.
+// Determinism: queries run in parallel, but each writes only its own slot, and the
+// tree is built serially, so results do not depend on the thread count.
+#pragma once
+#include <vector>
+
+#include "engine/block.h"
+
+namespace jsa {
+
+// queries: M x C, points: N x C (N >= 1). On return index has M entries,
+// index[i] = argmin_j |queries_i - points_j|^2, and if squared_distance is given
+// it holds the M minimal squared distances. Tuned (fixed-size code) for C = 2, 3,
+// 6; other C work through a generic path.
+template <class T>
+void nearest(const Block<T>& queries, const Block<T>& points, std::vector<int>& index,
+             std::vector<T>* squared_distance = nullptr);
+
+// The oracle: the obvious O(M N) double loop, same contract as nearest().
+template <class T>
+void nearest_brute_force(const Block<T>& queries, const Block<T>& points,
+                         std::vector<int>& index, std::vector<T>* squared_distance = nullptr);
+
+}  // namespace jsa
