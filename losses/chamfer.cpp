@@ -1,0 +1,81 @@
+// Chamfer distance, Eq. (6): a custom tape op. The forward pass is two
+// nearest-neighbour searches; the pull-back touches only the matched pairs.
+#include "losses/chamfer.h"
+
+#include "engine/parallel.h"
+#include "losses/nearest.h"
+
+namespace jsa {
+namespace {
+
+// Fills m with both associations; returns CD(x, y), summed in double, in order.
+template <class T>
+double match_both_ways(const Block<T>& x, const Block<T>& y, ChamferMatches<T>& m) {
+  JSA_CHECK(x.rows() > 0 && y.rows() > 0,
+            "chamfer of an empty set: " << x.rows() << " and " << y.rows() << " points");
+  JSA_CHECK(x.cols() == y.cols(), "chamfer: " << x.cols() << " vs " << y.cols() << " columns");
+  nearest(x, y, m.x_to_y, &m.x_squared_distance);
+  nearest(y, x, m.y_to_x, &m.y_squared_distance);
+  double sx = 0, sy = 0;
+  for (T d : m.x_squared_distance) sx += double(d);
+  for (T d : m.y_squared_distance) sy += double(d);
+  return sx / double(x.rows()) + sy / double(y.rows());
+}
+
+}  // namespace
+
+template <class T>
+double chamfer_distance(const Block<T>& x, const Block<T>& y, ChamferMatches<T>* matches) {
+  ChamferMatches<T> local;
+  return match_both_ways(x, y, matches ? *matches : local);
+}
+
+// L = 1/N sum_i |x_i - y_{a_i}|^2 + 1/M sum_j |y_j - x_{b_j}|^2, matches held fixed.
+// With r_i = x_i - y_{a_i} and s_j = y_j - x_{b_j}, and dL the incoming gradient:
+//   dx_i     += 2 dL/N r_i      dy_{a_i} -= 2 dL/N r_i
+//   dy_j     += 2 dL/M s_j      dx_{b_j} -= 2 dL/M s_j
+// The own-row terms write disjoint rows (parallel); the scatter-adds run serially
+// in index order, so the sums are the same for every thread count.
+template <class T>
+Var chamfer(Tape<T>& t, Var x, Var y, ChamferMatches<T>* matches) {
+  ChamferMatches<T> local;
+  ChamferMatches<T>& m = matches ? *matches : local;
+  const double value = match_both_ways(t.value(x), t.value(y), m);
+  Var out = t.node(1, 1, {x, y});
+  t.value(out)(0, 0) = T(value);
+  if (!t.needs_grad(out)) return out;
+
+  const int x_to_y = t.keep(m.x_to_y), y_to_x = t.keep(m.y_to_x);
+  t.on_backward(out, [x, y, x_to_y, y_to_x](Tape<T>& t, Var out) {
+    const std::vector<int>& a = t.kept(x_to_y);
+    const std::vector<int>& b = t.kept(y_to_x);
+    const Block<T>& X = t.value(x);
+    const Block<T>& Y = t.value(y);
+    const T dL = t.grad(out)(0, 0);
+    const T cx = T(2) * dL / T(X.rows()), cy = T(2) * dL / T(Y.rows());
+    if (t.needs_grad(x)) {
+      Block<T>& dX = t.grad(x);
+      parallel_rows(X.rows(), [&](Index begin, Index end) {
+        for (Index i = begin; i < end; ++i) dX.row(i) += cx * (X.row(i) - Y.row(a[i]));
+      });
+      for (Index j = 0; j < Y.rows(); ++j) dX.row(b[j]) -= cy * (Y.row(j) - X.row(b[j]));
+    }
+    if (t.needs_grad(y)) {
+      Block<T>& dY = t.grad(y);
+      parallel_rows(Y.rows(), [&](Index begin, Index end) {
+        for (Index j = begin; j < end; ++j) dY.row(j) += cy * (Y.row(j) - X.row(b[j]));
+      });
+      for (Index i = 0; i < X.rows(); ++i) dY.row(a[i]) -= cx * (X.row(i) - Y.row(a[i]));
+    }
+  });
+  return out;
+}
+
+#define JSA_INSTANTIATE(T)                                          \
+  template struct ChamferMatches<T>;                                \
+  template Var chamfer<T>(Tape<T>&, Var, Var, ChamferMatches<T>*); \
+  template double chamfer_distance<T>(const Block<T>&, const Block<T>&, ChamferMatches<T>*);
+JSA_INSTANTIATE(float)
+JSA_INSTANTIATE(double)
+
+}  // namespace jsa

@@ -1,0 +1,37 @@
+// The Chamfer distance, Eq. (6), with squared distances and a mean in both
+// directions; L_6D (Eq. 7) and L_2D (Eq. 8) are this op on 6- and 2-column blocks:
+//
+//   CD(X, Y) = 1/N sum_i min_j |x_i - y_j|^2  +  1/M sum_j min_i |y_j - x_i|^2
+//
+// X: N x C, Y: M x C. The nearest-neighbour assignment is piecewise constant, so
+// the gradient flows only through the matched pairs: with a_i the match of x_i in
+// Y and b_j the match of y_j in X,
+//   dL/dx_i = 2/N (x_i - y_{a_i}) - 2/M sum_{j : b_j = i} (y_j - x_i)
+//   dL/dy_j = 2/M (y_j - x_{b_j}) - 2/N sum_{i : a_i = j} (x_i - y_j)
+#pragma once
+#include <vector>
+
+#include "engine/tape.h"
+
+namespace jsa {
+
+// The association behind a Chamfer value, for evaluation (correspondences,
+// F-scores, per-point errors).
+template <class T>
+struct ChamferMatches {
+  std::vector<int> x_to_y;            // N: a_i, the row of Y nearest to x_i
+  std::vector<int> y_to_x;            // M: b_j, the row of X nearest to y_j
+  std::vector<T> x_squared_distance;  // N: |x_i - y_{a_i}|^2
+  std::vector<T> y_squared_distance;  // M: |y_j - x_{b_j}|^2
+};
+
+// CD(x, y) as a 1 x 1 tape node, differentiable in x and y (either may be a
+// constant). If matches is given it is filled with the association.
+template <class T>
+Var chamfer(Tape<T>& t, Var x, Var y, ChamferMatches<T>* matches = nullptr);
+
+// The same value without a tape (evaluation). Sums accumulate in double.
+template <class T>
+double chamfer_distance(const Block<T>& x, const Block<T>& y, ChamferMatches<T>* matches = nullptr);
+
+}  // namespace jsa

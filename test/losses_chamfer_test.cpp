@@ -1,0 +1,190 @@
+// The Chamfer op (Eq. 6): value against a brute-force double loop, gradients
+// against finite differences, and accumulation when many points share a match.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <limits>
+
+#include "engine/gradcheck.h"
+#include "engine/ops.h"
+#include "engine/rng.h"
+#include "losses/chamfer.h"
+
+using namespace jsa;
+
+namespace {
+
+Block<double> random_block(Index n, Index c, uint64_t seed) {
+  Rng rng(seed);
+  Block<double> b(n, c);
+  for (Index i = 0; i < b.size(); ++i) b.data()[i] = rng.uniform(-1, 1);
+  return b;
+}
+
+// 1/N sum_i min_j |x_i - y_j|^2, the obvious way.
+double one_way(const Block<double>& x, const Block<double>& y) {
+  double s = 0;
+  for (Index i = 0; i < x.rows(); ++i) {
+    double best = std::numeric_limits<double>::infinity();
+    for (Index j = 0; j < y.rows(); ++j) best = std::min(best, (x.row(i) - y.row(j)).squaredNorm());
+    s += best;
+  }
+  return s / double(x.rows());
+}
+
+// The gap between the nearest and the second-nearest squared distance of each
+// query, minimised over queries: if it is far above the finite-difference step,
+// no match can flip while the gradient checker perturbs one coordinate.
+double smallest_match_gap(const Block<double>& x, const Block<double>& y) {
+  double gap = std::numeric_limits<double>::infinity();
+  for (Index i = 0; i < x.rows(); ++i) {
+    double d1 = std::numeric_limits<double>::infinity(), d2 = d1;
+    for (Index j = 0; j < y.rows(); ++j) {
+      const double d = (x.row(i) - y.row(j)).squaredNorm();
+      if (d < d1) {
+        d2 = d1;
+        d1 = d;
+      } else {
+        d2 = std::min(d2, d);
+      }
+    }
+    gap = std::min(gap, d2 - d1);
+  }
+  return gap;
+}
+
+}  // namespace
+
+TEST_CASE("chamfer value equals the brute-force double loop", "[chamfer]") {
+  for (Index c : {2, 3, 6}) {
+    const Block<double> x = random_block(300, c, 100 + c), y = random_block(250, c, 200 + c);
+    const double expected = one_way(x, y) + one_way(y, x);
+    Tape<double> t;
+    ChamferMatches<double> m;
+    Var loss = chamfer(t, t.constant(x), t.constant(y), &m);
+    CHECK(t.scalar(loss) == Approx(expected).epsilon(1e-12));
+    CHECK(chamfer_distance(x, y) == Approx(expected).epsilon(1e-12));
+    REQUIRE(m.x_to_y.size() == 300);
+    REQUIRE(m.y_to_x.size() == 250);
+    REQUIRE(m.x_squared_distance.size() == 300);
+    for (Index i = 0; i < x.rows(); ++i)
+      CHECK(m.x_squared_distance[i] == Approx((x.row(i) - y.row(m.x_to_y[i])).squaredNorm()));
+    // float agrees with double to float precision
+    const Block<float> xf = x.cast<float>(), yf = y.cast<float>();
+    CHECK(chamfer_distance(xf, yf) == Approx(expected).epsilon(1e-5));
+  }
+}
+
+TEST_CASE("chamfer of a set with itself is zero", "[chamfer]") {
+  const Block<double> x = random_block(100, 3, 7);
+  CHECK(chamfer_distance(x, x) == 0);
+}
+
+TEST_CASE("chamfer gradient passes the finite-difference check", "[chamfer]") {
+  // Random points are in general position: the nearest and second-nearest
+  // squared distances of every query differ by far more than the step (1e-6
+  // relative), so no match flips during the check and the loss is smooth there.
+  const Block<double> x = random_block(40, 3, 300), y = random_block(30, 3, 301);
+  REQUIRE(smallest_match_gap(x, y) > 1e-4);
+  REQUIRE(smallest_match_gap(y, x) > 1e-4);
+  const GradCheckResult r = check_gradients(
+      [](Tape<double>& t, const std::vector<Var>& v) { return chamfer(t, v[0], v[1]); }, {x, y});
+  INFO(r.report);
+  CHECK(r.ok);
+
+  // 2D, the L_2D shape, and chamfer feeding further ops (gradient scaled on the way).
+  const Block<double> u = random_block(25, 2, 310), w = random_block(35, 2, 311);
+  REQUIRE(smallest_match_gap(u, w) > 1e-4);
+  REQUIRE(smallest_match_gap(w, u) > 1e-4);
+  const GradCheckResult r2 = check_gradients(
+      [](Tape<double>& t, const std::vector<Var>& v) {
+        return scale(t, chamfer(t, v[0], v[1]), 3.0);
+      },
+      {u, w});
+  INFO(r2.report);
+  CHECK(r2.ok);
+}
+
+TEST_CASE("chamfer accumulates gradients on shared matches", "[chamfer]") {
+  // y_0 is near the eight x, y_1 and y_2 far away: every a_i = 0, so
+  // y_0 collects eight pull-backs, and y_1, y_2 both match the x of largest
+  // first coordinate, which collects two.
+  Block<double> y(3, 2);
+  y << 0, 0, 10, 0, 10, 1;
+  Rng rng(400);
+  Block<double> x(8, 2);
+  for (Index i = 0; i < x.rows(); ++i) x.row(i) << rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5);
+
+  Tape<double> t;
+  ChamferMatches<double> m;
+  Var vx = t.variable(x), vy = t.variable(y);
+  Var loss = chamfer(t, vx, vy, &m);
+  t.backward(loss);
+  for (int a : m.x_to_y) CHECK(a == 0);
+  CHECK(m.y_to_x[1] == m.y_to_x[2]);
+
+  // The gradient of y, written out from the formula in chamfer.h.
+  const double N = 8, M = 3;
+  Block<double> dy = Block<double>::Zero(3, 2), dx = Block<double>::Zero(8, 2);
+  for (Index i = 0; i < 8; ++i) {
+    dx.row(i) += 2 / N * (x.row(i) - y.row(0));
+    dy.row(0) -= 2 / N * (x.row(i) - y.row(0));
+  }
+  for (Index j = 0; j < 3; ++j) {
+    const Index b = m.y_to_x[j];
+    dy.row(j) += 2 / M * (y.row(j) - x.row(b));
+    dx.row(b) -= 2 / M * (y.row(j) - x.row(b));
+  }
+  CHECK((t.grad(vy) - dy).cwiseAbs().maxCoeff() < 1e-12);
+  CHECK((t.grad(vx) - dx).cwiseAbs().maxCoeff() < 1e-12);
+
+  // And the finite-difference check agrees (the matches are stable, see above).
+  REQUIRE(smallest_match_gap(x, y) > 1e-4);
+  REQUIRE(smallest_match_gap(y, x) > 1e-4);
+  const GradCheckResult r = check_gradients(
+      [](Tape<double>& t, const std::vector<Var>& v) { return chamfer(t, v[0], v[1]); }, {x, y});
+  INFO(r.report);
+  CHECK(r.ok);
+}
+
+TEST_CASE("chamfer with a constant side only differentiates the other", "[chamfer]") {
+  const Block<float> x = random_block(50, 6, 500).cast<float>(), y = random_block(60, 6, 501).cast<float>();
+  Tape<float> t;
+  Var vx = t.variable(x), vy = t.constant(y);
+  Var loss = chamfer(t, vx, vy);
+  t.backward(loss);
+  CHECK(t.grad(vx).rows() == 50);
+  CHECK(t.grad(vx).allFinite());
+  CHECK(!t.needs_grad(vy));
+  // Reusing the tape gives the same numbers (storage kept between steps).
+  const Block<float> first = t.grad(vx);
+  t.clear();
+  vx = t.variable(x);
+  vy = t.constant(y);
+  loss = chamfer(t, vx, vy);
+  t.backward(loss);
+  CHECK(t.grad(vx) == first);
+}
+
+TEST_CASE("chamfer timing at training-loop sizes", "[.bench][chamfer]") {
+  // L_6D shape: 10^4 x 10^4 points in 6 columns, float, forward + backward:
+  // xyz in a cube, the last three columns scaled to ~0.01 like the normals.
+  Block<float> x = random_block(10000, 6, 600).cast<float>();
+  Block<float> y = random_block(10000, 6, 601).cast<float>();
+  x.rightCols(3) *= 0.01f;
+  y.rightCols(3) *= 0.01f;
+  Tape<float> t;
+  std::vector<double> ms;
+  for (int r = 0; r < 15; ++r) {
+    const auto t0 = std::chrono::steady_clock::now();
+    t.clear();
+    Var vx = t.variable(x), vy = t.constant(y);
+    t.backward(chamfer(t, vx, vy));
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  }
+  std::sort(ms.begin(), ms.end());
+  std::printf("chamfer 10^4 x 10^4 x 6 (xyz + 0.01 normals), forward + backward, median of 15: %.2f ms\n",
+              ms[ms.size() / 2]);
+}
