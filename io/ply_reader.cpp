@@ -252,6 +252,13 @@ class PlyBody {
   const std::string* field_ = nullptr;
 };
 
+// A value read from the file, printed as an integer when it is one.
+std::string shown(double value) {
+  if (value == std::floor(value) && std::abs(value) < 1e15)
+    return std::to_string(static_cast<long long>(value));
+  return std::to_string(value);
+}
+
 int find_property(const PlyElement& element, const std::string& name) {
   for (std::size_t i = 0; i < element.properties.size(); ++i)
     if (element.properties[i].name == name) return int(i);
@@ -307,15 +314,14 @@ void read_faces(const std::string& path, const PlyElement& element, PlyBody& bod
       }
       const double n = body.value(property.count_type, property.name);
       if (int(p) == slot && (n < 3 || n != std::floor(n)))
-        body.fail(property.name, "a face needs at least 3 vertex indices, found " +
-                                     std::to_string(n));
+        body.fail(property.name, "a face needs at least 3 vertex indices, found " + shown(n));
       polygon.clear();
       for (double k = 0; k < n; ++k) {
         const double index = body.value(property.type, property.name);
         if (int(p) != slot) continue;
         if (index < 0 || index != std::floor(index) ||
             (vertex_count >= 0 && index >= double(vertex_count)))
-          body.fail(property.name, "vertex index " + std::to_string(index) +
+          body.fail(property.name, "vertex index " + shown(index) +
                                        " is out of range [0, " + std::to_string(vertex_count) +
                                        ")");
         polygon.push_back(int(index));
