@@ -54,11 +54,14 @@ Index count_components(const Mesh& mesh) {
 
 Index count_non_manifold_edges(const Mesh& mesh) {
   std::map<std::pair<int, int>, int> faces_per_edge;
-  for (Index f = 0; f < mesh.faces.rows(); ++f)
+  for (Index f = 0; f < mesh.faces.rows(); ++f) {
+    const auto face = mesh.faces.row(f);
+    if (face(0) == face(1) || face(1) == face(2) || face(2) == face(0)) continue;  // a sliver
     for (int k = 0; k < 3; ++k) {
-      const int a = mesh.faces(f, k), b = mesh.faces(f, (k + 1) % 3);
-      if (a != b) ++faces_per_edge[{std::min(a, b), std::max(a, b)}];
+      const int a = face(k), b = face((k + 1) % 3);
+      ++faces_per_edge[{std::min(a, b), std::max(a, b)}];
     }
+  }
   Index count = 0;
   for (const auto& entry : faces_per_edge) count += entry.second > 2;
   return count;
