@@ -10,6 +10,7 @@ Var linear(Tape<T>& t, Var x, Var w, Var b, Index bias_rows) {
   const Index n = t.rows(x), cin = t.cols(x), cout = t.cols(w);
   JSA_CHECK(t.rows(w) == cin, "linear: X is " << n << "x" << cin << ", W is " << t.rows(w) << "x" << cout);
   if (bias_rows < 0) bias_rows = n;
+  JSA_CHECK(bias_rows <= n, "linear: bias on " << bias_rows << " rows of " << n);
   Var y = b.valid() ? t.node(n, cout, {x, w, b}) : t.node(n, cout, {x, w});
   Block<T>& Y = t.value(y);
   Y.noalias() = t.value(x) * t.value(w);  // one GEMM, threaded by Eigen

@@ -65,6 +65,8 @@ void Parameters<T>::load(std::istream& in, const std::string& what) {
   if (count != entries_.size())
     throw InputError(what + ": holds " + std::to_string(count) + " parameters, the model has " +
                      std::to_string(entries_.size()));
+  // The count matches, so every parameter is present iff no name repeats.
+  std::vector<bool> seen(entries_.size(), false);
   for (uint32_t k = 0; k < count; ++k) {
     uint32_t len = 0;
     get(&len, sizeof len);
@@ -76,6 +78,8 @@ void Parameters<T>::load(std::istream& in, const std::string& what) {
     get(&c, sizeof c);
     const int i = find(name);
     if (i < 0) throw InputError(what + ": unknown parameter '" + name + "'");
+    if (seen[i]) throw InputError(what + ": parameter '" + name + "' appears twice (corrupt file?)");
+    seen[i] = true;
     if (r != entries_[i].rows || c != entries_[i].cols)
       throw InputError(what + ": parameter '" + name + "' is " + std::to_string(r) + "x" +
                        std::to_string(c) + ", the model wants " + std::to_string(entries_[i].rows) +

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "engine/check.h"
+
 namespace jsa {
 namespace {
 
@@ -36,6 +38,7 @@ uint64_t Rng::next() {
 double Rng::uniform() { return double(next() >> 11) * 0x1.0p-53; }
 
 uint64_t Rng::below(uint64_t n) {
+  JSA_CHECK(n > 0, "below(0): the range [0, 0) is empty");
   // Lemire's rejection: unbiased without a division in the common case.
   const uint64_t threshold = (0 - n) % n;
   for (;;) {

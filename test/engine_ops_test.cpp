@@ -248,6 +248,8 @@ TEST_CASE("shape errors are programmer errors", "[ops][errors]") {
   Var a = t.constant(Block<double>::Ones(3, 4));
   CHECK_THROWS_AS(add(t, a, t.constant(Block<double>::Ones(2, 4))), InternalError);
   CHECK_THROWS_AS(linear(t, a, t.constant(Block<double>::Ones(3, 2)), Var{}), InternalError);
+  CHECK_THROWS_AS(linear(t, a, t.constant(Block<double>::Ones(4, 2)), t.constant(Block<double>::Ones(1, 2)), 5),
+                  InternalError);  // bias on more rows than there are
   CHECK_THROWS_AS(relu_masked(t, a, 2), InternalError);
   CHECK_THROWS_AS(slice_cols(t, a, 2, 3), InternalError);
   CHECK_THROWS_AS(gather_rows(t, a, {0, 3}), InternalError);

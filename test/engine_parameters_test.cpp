@@ -117,6 +117,27 @@ TEST_CASE("bad parameter files throw InputError naming the file", "[parameters][
       CHECK_THROWS_AS(load_into(p, good.substr(0, cut)), InputError);
     }
   }
+  SECTION("a name twice (so another is missing)") {
+    // count = 2, then "a" 1x1 twice, written field by field as save() does.
+    std::ostringstream out;
+    auto put = [&](const void* q, size_t n) { out.write(static_cast<const char*>(q), std::streamsize(n)); };
+    const uint32_t count = 2, len = 1;
+    const int64_t one = 1;
+    const float value = 3.0f;
+    put(&count, sizeof count);
+    for (int k = 0; k < 2; ++k) {
+      put(&len, sizeof len);
+      put("a", 1);
+      put(&one, sizeof one);
+      put(&one, sizeof one);
+      put(&value, sizeof value);
+    }
+    Parameters<float> p;
+    p.add("a", 1, 1);
+    p.add("b", 1, 1);
+    CHECK_THROWS_AS(load_into(p, out.str()), InputError);
+    CHECK_THROWS_WITH(load_into(p, out.str()), Catch::Contains("twice"));
+  }
   SECTION("corrupt name length") {
     std::string bad = good;
     bad[4] = char(0xff);  // first name length becomes > 4096

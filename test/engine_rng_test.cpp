@@ -11,6 +11,7 @@
 
 #include <set>
 
+#include "engine/check.h"
 #include "engine/rng.h"
 
 namespace jsa {
@@ -105,6 +106,7 @@ TEST_CASE("below(n) stays in [0, n) and reaches every value", "[rng]") {
     INFO("n = " << n);
     CHECK(seen.size() == n);
   }
+  CHECK_THROWS_AS(rng.below(0), InternalError);  // empty range: a programmer error
   // A bound past 2^63, where a naive modulo would be badly biased.
   const uint64_t big = (uint64_t(1) << 63) + 12345;
   int upper = 0;
