@@ -81,6 +81,29 @@ TEST_CASE("Adam matches the update rule over three steps", "[adam]") {
   CHECK(q.values()[0] == Approx(t2).epsilon(1e-13));
 }
 
+TEST_CASE("Adam over a buffer past the parallel grain matches the rule", "[adam][parallel]") {
+  // 300 x 300 = 90,000 entries > the 65,536-entry grain: the update runs in chunks.
+  Parameters<double> p;
+  p.add("w", 300, 300);
+  Rng rng(8);
+  for (double& x : p.values()) x = rng.uniform(-1, 1);
+  std::vector<double> theta = p.values(), m(p.size(), 0), v(p.size(), 0);
+  Adam<double> adam;
+  for (int t = 1; t <= 2; ++t) {
+    for (size_t i = 0; i < p.size(); ++i) p.grads()[i] = std::sin(double(i) + t) * (1 + theta[i]);
+    adam.step(p, 1e-2);
+    for (size_t i = 0; i < p.size(); ++i) {
+      const double g = p.grads()[i];
+      m[i] = 0.9 * m[i] + 0.1 * g;
+      v[i] = 0.999 * v[i] + 0.001 * g * g;
+      theta[i] -= 1e-2 * (m[i] / (1 - std::pow(0.9, t))) / (std::sqrt(v[i] / (1 - std::pow(0.999, t))) + 1e-8);
+    }
+  }
+  double worst = 0;
+  for (size_t i = 0; i < p.size(); ++i) worst = std::max(worst, std::abs(p.values()[i] - theta[i]));
+  CHECK(worst < 1e-12);
+}
+
 TEST_CASE("a zero gradient moves nothing", "[adam]") {
   Parameters<float> p;
   p.add("w", 2, 3);

@@ -257,3 +257,72 @@ TEST_CASE("shape errors are programmer errors", "[ops][errors]") {
 }
 
 }  // namespace jsa::test
+
+namespace jsa::test {
+
+// The gradient checks above use blocks far below parallel_rows' grain (2048
+// rows), so they run serially. Here blocks are tall enough to be split across
+// threads; each result must equal a plain loop exactly (disjoint rows, same
+// arithmetic, so not even round-off differs).
+TEST_CASE("tall blocks (parallel path) equal a plain loop", "[ops][parallel]") {
+  const Index m = 5000, c = 7;  // 3 stacked blocks of 5000 rows
+  Rng rng(17);
+  const Block<double> x0 = signed_block(rng, 3 * m, c), w0 = signed_block(rng, c, c),
+                      b0 = signed_block(rng, 1, c), dy0 = signed_block(rng, 3 * m, c);
+
+  SECTION("relu_masked") {
+    Tape<double> t;
+    Var x = t.variable(x0);
+    Var y = relu_masked(t, x, m);
+    t.backward(sum(t, mul(t, y, t.constant(dy0))));
+    Block<double> y_ref(3 * m, c), dx_ref(3 * m, c);
+    for (Index k = 0; k < 3; ++k)
+      for (Index i = 0; i < m; ++i)
+        for (Index j = 0; j < c; ++j) {
+          const bool on = x0(i, j) > 0;
+          y_ref(k * m + i, j) = on ? x0(k * m + i, j) : 0.0;
+          dx_ref(k * m + i, j) = on ? dy0(k * m + i, j) : 0.0;
+        }
+    CHECK(t.value(y) == y_ref);
+    CHECK(t.grad(x) == dx_ref);
+  }
+  SECTION("linear with the bias on the first N rows") {
+    Tape<double> t;
+    Var x = t.variable(x0), w = t.variable(w0), b = t.variable(b0);
+    Var y = linear(t, x, w, b, m);
+    t.backward(sum(t, mul(t, y, t.constant(dy0))));
+    Block<double> y_ref = x0 * w0;
+    RowVector<double> db_ref = RowVector<double>::Zero(c);
+    for (Index i = 0; i < m; ++i) {
+      y_ref.row(i) += b0.row(0);
+      db_ref += dy0.row(i);
+    }
+    CHECK((t.value(y) - y_ref).cwiseAbs().maxCoeff() < 1e-13);
+    CHECK((t.grad(b) - db_ref).cwiseAbs().maxCoeff() < 1e-10);
+    CHECK((t.grad(w) - x0.transpose() * dy0).cwiseAbs().maxCoeff() < 1e-10);
+    CHECK((t.grad(x) - dy0 * w0.transpose()).cwiseAbs().maxCoeff() < 1e-13);
+  }
+}
+
+// float and double instantiations compute the same thing (to float precision).
+TEST_CASE("float ops agree with double ops", "[ops][float]") {
+  Rng rng(23);
+  const Block<double> x0 = signed_block(rng, 9, 3), w0 = signed_block(rng, 3, 3), b0 = signed_block(rng, 1, 3);
+  auto run = [&](auto scalar) {
+    using S = decltype(scalar);
+    Tape<S> t;
+    Var x = t.variable(x0.cast<S>());
+    Var h = relu_masked(t, linear(t, stack_tangents(t, x), t.constant(w0.cast<S>()), t.constant(b0.cast<S>()), 9),
+                        9);
+    Var loss = mean(t, row_norm(t, cross3(t, slice_rows(t, h, 9, 9), slice_rows(t, h, 18, 9))));
+    loss = add(t, loss, mean(t, exp(t, scale(t, row_normalize(t, slice_rows(t, h, 0, 9)), S(0.5)))));
+    t.backward(loss);
+    return std::make_pair(double(t.scalar(loss)), Block<double>(t.grad(x).template cast<double>()));
+  };
+  const auto [lf, gf] = run(0.0f);
+  const auto [ld, gd] = run(0.0);
+  CHECK(lf == Approx(ld).epsilon(1e-5));
+  CHECK((gf - gd).cwiseAbs().maxCoeff() < 1e-5 * std::max(1.0, gd.cwiseAbs().maxCoeff()));
+}
+
+}  // namespace jsa::test
