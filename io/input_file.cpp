@@ -22,11 +22,15 @@ void input_error(const std::string& path, const std::string& where, const std::s
 
 std::string line_label(std::int64_t line) { return "line " + std::to_string(line); }
 
-std::string read_input_file(const std::string& path) {
+void check_regular_file(const std::string& path) {
   struct stat info;
   if (::stat(path.c_str(), &info) != 0)
     input_error(path, "", std::string("cannot open (") + std::strerror(errno) + ")");
   if (S_ISDIR(info.st_mode)) input_error(path, "", "is a directory, expected a shape file");
+}
+
+std::string read_input_file(const std::string& path) {
+  check_regular_file(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) input_error(path, "", "cannot open for reading");
   std::ostringstream bytes;

@@ -14,6 +14,9 @@ namespace jsa {
 // "line 12" — the usual `where` for text formats.
 std::string line_label(std::int64_t line);
 
+// Rejects a missing path and a directory (before we look at the extension).
+void check_regular_file(const std::string& path);
+
 // The whole file as bytes. Rejects a missing path, a directory and an empty file.
 std::string read_input_file(const std::string& path);
 

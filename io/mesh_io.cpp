@@ -14,6 +14,7 @@
 namespace jsa {
 
 Mesh read_shape(const std::string& path) {
+  check_regular_file(path);
   const std::string extension = extension_of(path);
   Mesh mesh;
   if (extension == ".obj")

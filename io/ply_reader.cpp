@@ -319,8 +319,8 @@ void read_faces(const std::string& path, const PlyElement& element, PlyBody& bod
       for (double k = 0; k < n; ++k) {
         const double index = body.value(property.type, property.name);
         if (int(p) != slot) continue;
-        if (index < 0 || index != std::floor(index) ||
-            (vertex_count >= 0 && index >= double(vertex_count)))
+        const double limit = vertex_count >= 0 ? double(vertex_count) : 2147483647.0;
+        if (index < 0 || index != std::floor(index) || index >= limit)
           body.fail(property.name, "vertex index " + shown(index) +
                                        " is out of range [0, " + std::to_string(vertex_count) +
                                        ")");

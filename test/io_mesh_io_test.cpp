@@ -109,6 +109,21 @@ TEST_CASE("OBJ polygons are triangulated and v+vn without faces is a point cloud
   CHECK(cloud.normals(1, 1) == Approx(1));
 }
 
+TEST_CASE("an oriented point cloud round-trips through OBJ v and vn lines", "[io][mesh_io]") {
+  ScratchDir dir;
+  jsa::Mesh cloud;
+  cloud.vertices.resize(2, 3);
+  cloud.vertices << 0.5, 1, 2, -1, 0, 3;
+  cloud.normals.resize(2, 3);
+  cloud.normals << 0, 0, 1, 0.6, 0.8, 0;
+  cloud.faces.resize(0, 3);
+  jsa::write_obj(dir.path + "/cloud.obj", cloud);
+  const jsa::Mesh back = jsa::read_shape(dir.path + "/cloud.obj");
+  CHECK(back.is_point_cloud());
+  CHECK((back.vertices - cloud.vertices).cwiseAbs().maxCoeff() < 1e-6);
+  CHECK((back.normals - cloud.normals).cwiseAbs().maxCoeff() < 1e-6);
+}
+
 TEST_CASE("OFF files are read: counts on the keyword line, NOFF normals, polygons",
           "[io][mesh_io]") {
   ScratchDir dir;
@@ -146,6 +161,7 @@ TEST_CASE("files that are not shapes are rejected naming the file", "[io][mesh_i
   const std::string folder = dir.path + "/folder.obj";
   std::filesystem::create_directory(folder);
   CHECK(message_of([&] { jsa::read_shape(folder); }).find(folder + ": is a directory") == 0);
+  CHECK(message_of([&] { jsa::read_shape(dir.path); }).find(dir.path + ": is a directory") == 0);
   check_rejects(dir, "empty.off", "", "file is empty");
   check_rejects(dir, "shape.stl", "solid x\n", "unknown extension '.stl'");
   check_rejects(dir, "binary.obj", std::string("v 0 0 0\n\x7f\x00\x01garbage", 18),
