@@ -71,8 +71,8 @@ Var chamfer(Tape<T>& t, Var x, Var y, ChamferMatches<T>* matches) {
   return out;
 }
 
-#define JSA_INSTANTIATE(T)                                          \
-  template struct ChamferMatches<T>;                                \
+#define JSA_INSTANTIATE(T)                                         \
+  template struct ChamferMatches<T>;                               \
   template Var chamfer<T>(Tape<T>&, Var, Var, ChamferMatches<T>*); \
   template double chamfer_distance<T>(const Block<T>&, const Block<T>&, ChamferMatches<T>*);
 JSA_INSTANTIATE(float)

@@ -122,10 +122,14 @@ void nearest(const Block<T>& queries, const Block<T>& points, std::vector<int>& 
   index.resize(queries.rows());
   if (squared_distance) squared_distance->resize(queries.rows());
   switch (points.cols()) {
-    case 2: return nearest_kdtree<T, 2>(queries, points, index, squared_distance);
-    case 3: return nearest_kdtree<T, 3>(queries, points, index, squared_distance);
-    case 6: return nearest_kdtree<T, 6>(queries, points, index, squared_distance);
-    default: return nearest_kdtree<T, -1>(queries, points, index, squared_distance);
+    case 2:
+      return nearest_kdtree<T, 2>(queries, points, index, squared_distance);
+    case 3:
+      return nearest_kdtree<T, 3>(queries, points, index, squared_distance);
+    case 6:
+      return nearest_kdtree<T, 6>(queries, points, index, squared_distance);
+    default:
+      return nearest_kdtree<T, -1>(queries, points, index, squared_distance);
   }
 }
 
@@ -154,10 +158,9 @@ void nearest_brute_force(const Block<T>& queries, const Block<T>& points, std::v
   }
 }
 
-#define JSA_INSTANTIATE(T)                                                                  \
-  template void nearest<T>(const Block<T>&, const Block<T>&, std::vector<int>&,            \
-                           std::vector<T>*);                                               \
-  template void nearest_brute_force<T>(const Block<T>&, const Block<T>&, std::vector<int>&, \
+#define JSA_INSTANTIATE(T)                                                                        \
+  template void nearest<T>(const Block<T>&, const Block<T>&, std::vector<int>&, std::vector<T>*); \
+  template void nearest_brute_force<T>(const Block<T>&, const Block<T>&, std::vector<int>&,       \
                                        std::vector<T>*);
 JSA_INSTANTIATE(float)
 JSA_INSTANTIATE(double)

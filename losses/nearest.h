@@ -24,7 +24,7 @@ void nearest(const Block<T>& queries, const Block<T>& points, std::vector<int>& 
 
 // The oracle: the obvious O(M N) double loop, same contract as nearest().
 template <class T>
-void nearest_brute_force(const Block<T>& queries, const Block<T>& points,
-                         std::vector<int>& index, std::vector<T>* squared_distance = nullptr);
+void nearest_brute_force(const Block<T>& queries, const Block<T>& points, std::vector<int>& index,
+                         std::vector<T>* squared_distance = nullptr);
 
 }  // namespace jsa

@@ -18,7 +18,8 @@ namespace jsa {
 
 template <class T>
 double repulsion_exact(const Block<T>& mu, T sigma, Block<T>* dmu) {
-  JSA_CHECK(mu.cols() == 2, "repulsion: mu is " << mu.rows() << " x " << mu.cols() << ", not K x 2");
+  JSA_CHECK(mu.cols() == 2,
+            "repulsion: mu is " << mu.rows() << " x " << mu.cols() << ", not K x 2");
   JSA_CHECK(sigma > 0, "repulsion: sigma = " << sigma);
   const Index K = mu.rows();
   if (dmu) dmu->setZero(K, 2);
@@ -55,8 +56,12 @@ struct Grid {
   std::vector<Index> cell_of;  // K: the cell of mu_i (original order)
   std::vector<Index> start;    // nx * ny + 1
   std::vector<Index> order;    // sorted position -> original row
-  Index cell_x(double x) const { return std::clamp(Index(std::floor((x - x0) / h)), Index(0), nx - 1); }
-  Index cell_y(double y) const { return std::clamp(Index(std::floor((y - y0) / h)), Index(0), ny - 1); }
+  Index cell_x(double x) const {
+    return std::clamp(Index(std::floor((x - x0) / h)), Index(0), nx - 1);
+  }
+  Index cell_y(double y) const {
+    return std::clamp(Index(std::floor((y - y0) / h)), Index(0), ny - 1);
+  }
 };
 
 // Cells of side h = r_c / 4, so the cells a disc of radius r_c touches hug the
@@ -106,7 +111,8 @@ void build_grid(const Block<T>& mu, double r_c, Grid& g, std::vector<T>& xs, std
 // smallest normal T; only a d_ij below it would be mis-scaled).
 template <class T>
 double repulsion_cutoff(const Block<T>& mu, T sigma, Block<T>* dmu, const RepulsionOptions& o) {
-  JSA_CHECK(mu.cols() == 2, "repulsion: mu is " << mu.rows() << " x " << mu.cols() << ", not K x 2");
+  JSA_CHECK(mu.cols() == 2,
+            "repulsion: mu is " << mu.rows() << " x " << mu.cols() << ", not K x 2");
   JSA_CHECK(sigma > 0, "repulsion: sigma = " << sigma);
   JSA_CHECK(o.tolerance > 0 && o.tolerance < 1, "repulsion: tolerance = " << o.tolerance);
   const Index K = mu.rows();
@@ -129,7 +135,7 @@ double repulsion_cutoff(const Block<T>& mu, T sigma, Block<T>* dmu, const Repuls
 
 #pragma omp parallel
   {
-    Array dx, dy, d, w;  // per-thread scratch, resized only when a run is longer
+    Array dx, dy, d, w;  // per-thread scratch; a run uses the first n entries
 #pragma omp for schedule(dynamic, 64)
     for (Index s = 0; s < K; ++s) {  // sorted order: neighbouring means share runs
       const Index i = g.order[s];
@@ -146,15 +152,19 @@ double repulsion_cutoff(const Block<T>& mu, T sigma, Block<T>* dmu, const Repuls
         const Index last = g.start[ry * g.nx + g.cell_x(double(xi) + half_chord) + 1];
         const Index n = last - first;
         if (n == 0) continue;
-        dx = xi - ConstMap(xs.data() + first, n);
-        dy = yi - ConstMap(ys.data() + first, n);
-        d = (dx * dx + dy * dy).sqrt();
-        w = (d * -inv_sigma).exp();
-        row += double(w.sum());
+        if (n > dx.size()) {  // grow the scratch (rarely: it only ever grows)
+          for (Array* a : {&dx, &dy, &d, &w}) a->resize(std::max(n, 2 * a->size()));
+        }
+        auto dx_n = dx.head(n), dy_n = dy.head(n), d_n = d.head(n), w_n = w.head(n);
+        dx_n = xi - ConstMap(xs.data() + first, n);
+        dy_n = yi - ConstMap(ys.data() + first, n);
+        d_n = (dx_n * dx_n + dy_n * dy_n).sqrt();
+        w_n = (d_n * -inv_sigma).exp();
+        row += double(w_n.sum());
         if (dmu) {
-          w /= d.max(tiny);  // now w_ij / d_ij
-          gx += (w * dx).sum();
-          gy += (w * dy).sum();
+          w_n /= d_n.max(tiny);  // now w_ij / d_ij
+          gx += (w_n * dx_n).sum();
+          gy += (w_n * dy_n).sum();
         }
       }
       rows[i] = row;
@@ -185,8 +195,8 @@ Var repulsion(Tape<T>& t, Var mu, T sigma, const RepulsionOptions& o) {
   return out;
 }
 
-#define JSA_INSTANTIATE(T)                                                                   \
-  template Var repulsion<T>(Tape<T>&, Var, T, const RepulsionOptions&);                      \
+#define JSA_INSTANTIATE(T)                                                                     \
+  template Var repulsion<T>(Tape<T>&, Var, T, const RepulsionOptions&);                        \
   template double repulsion_cutoff<T>(const Block<T>&, T, Block<T>*, const RepulsionOptions&); \
   template double repulsion_exact<T>(const Block<T>&, T, Block<T>*);
 JSA_INSTANTIATE(float)

@@ -1,8 +1,7 @@
 // The Chamfer op (Eq. 6): value against a brute-force double loop, gradients
 // against finite differences, and accumulation when many points share a match.
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <chrono>
 #include <cstdio>
 #include <limits>
@@ -150,7 +149,8 @@ TEST_CASE("chamfer accumulates gradients on shared matches", "[chamfer]") {
 }
 
 TEST_CASE("chamfer with a constant side only differentiates the other", "[chamfer]") {
-  const Block<float> x = random_block(50, 6, 500).cast<float>(), y = random_block(60, 6, 501).cast<float>();
+  const Block<float> x = random_block(50, 6, 500).cast<float>(),
+                     y = random_block(60, 6, 501).cast<float>();
   Tape<float> t;
   Var vx = t.variable(x), vy = t.constant(y);
   Var loss = chamfer(t, vx, vy);
@@ -182,9 +182,11 @@ TEST_CASE("chamfer timing at training-loop sizes", "[.bench][chamfer]") {
     t.clear();
     Var vx = t.variable(x), vy = t.constant(y);
     t.backward(chamfer(t, vx, vy));
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
   std::sort(ms.begin(), ms.end());
-  std::printf("chamfer 10^4 x 10^4 x 6 (xyz + 0.01 normals), forward + backward, median of 15: %.2f ms\n",
-              ms[ms.size() / 2]);
+  std::printf(
+      "chamfer 10^4 x 10^4 x 6 (xyz + 0.01 normals), forward + backward, median of 15: %.2f ms\n",
+      ms[ms.size() / 2]);
 }

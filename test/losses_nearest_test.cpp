@@ -1,9 +1,8 @@
 // nearest() against its brute-force oracle, in the dimensions the model uses
 // (2: the domain, 3: xyz, 6: xyz + scaled normals) and one generic (5). The
 // [.bench] case times the training-loop sizes: `test_losses "[.bench]"`.
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <chrono>
 #include <cstdio>
 
@@ -114,7 +113,8 @@ TEST_CASE("nearest with one point, and with no queries", "[nearest]") {
 }
 
 TEST_CASE("nearest does not depend on the thread count", "[nearest]") {
-  const Block<float> q = points_with_normals<float>(3000, 51), p = points_with_normals<float>(3000, 52);
+  const Block<float> q = points_with_normals<float>(3000, 51),
+                     p = points_with_normals<float>(3000, 52);
   std::vector<int> a, b;
   std::vector<float> da, db;
   const int threads = max_threads();
@@ -134,14 +134,16 @@ TEST_CASE("nearest timing at training-loop sizes", "[.bench][nearest]") {
     for (int r = 0; r < 15; ++r) {
       const auto t0 = std::chrono::steady_clock::now();
       f();
-      ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      ms.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     }
     std::sort(ms.begin(), ms.end());
     return ms[ms.size() / 2];
   };
   std::vector<int> index, oracle;
   const Block<float> q2 = random_block<float>(10000, 2, 61), p2 = random_block<float>(10000, 2, 62);
-  const Block<float> q6 = points_with_normals<float>(10000, 63), p6 = points_with_normals<float>(10000, 64);
+  const Block<float> q6 = points_with_normals<float>(10000, 63),
+                     p6 = points_with_normals<float>(10000, 64);
   nearest(q2, p2, index);
   nearest_brute_force(q2, p2, oracle);
   REQUIRE(index == oracle);  // validate, then time
@@ -151,6 +153,8 @@ TEST_CASE("nearest timing at training-loop sizes", "[.bench][nearest]") {
   const double k2 = median_ms([&] { nearest(q2, p2, index); });
   const double k6 = median_ms([&] { nearest(q6, p6, index); });
   const double b2 = median_ms([&] { nearest_brute_force(q2, p2, oracle); });
-  std::printf("nearest 10^4 x 10^4, %d threads, median of 15: 2D %.2f ms, 6D %.2f ms"
-              " (brute force 2D %.1f ms)\n", max_threads(), k2, k6, b2);
+  std::printf(
+      "nearest 10^4 x 10^4, %d threads, median of 15: 2D %.2f ms, 6D %.2f ms"
+      " (brute force 2D %.1f ms)\n",
+      max_threads(), k2, k6, b2);
 }

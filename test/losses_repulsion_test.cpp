@@ -1,9 +1,8 @@
 // Repulsion (Eq. 11): the grid cut-off against the exact O(K^2) oracle within
 // the bounds stated in repulsion.h, a two-point case by hand, and the tape op's
 // gradient against finite differences. `test_losses "[.bench]"` times K = 10^4.
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -53,20 +52,22 @@ TEST_CASE("repulsion cut-off stays within its bounds of the exact sum", "[repuls
   Block<float> grad_f;
   const double value_f = repulsion_cutoff<float>(mu.cast<float>(), float(sigma), &grad_f);
   CHECK(value_f == Approx(exact).epsilon(1e-5));
-  CHECK(worst_row_error(grad_f.cast<double>(), exact_grad) < 1e-4 * exact_grad.cwiseAbs().maxCoeff());
+  CHECK(worst_row_error(grad_f.cast<double>(), exact_grad) <
+        1e-4 * exact_grad.cwiseAbs().maxCoeff());
 }
 
 TEST_CASE("repulsion of two points by hand", "[repulsion]") {
   // mu_0 = (0, 0), mu_1 = (d, 0), K = 2:
   //   L = 1/4 (1 + 1 + 2 exp(-d/sigma))
-  //   dL/dmu_0 = 1/4 * 2 * (-1/sigma) exp(-d/sigma) (mu_0 - mu_1)/d = (exp(-d/sigma) / (2 sigma), 0)
-  //   dL/dmu_1 = -dL/dmu_0
+  //   dL/dmu_0 = 1/4 * 2 * (-1/sigma) exp(-d/sigma) (mu_0 - mu_1)/d = (exp(-d/sigma) / (2 sigma),
+  //   0) dL/dmu_1 = -dL/dmu_0
   const double d = 0.3, sigma = 0.2, e = std::exp(-d / sigma);
   Block<double> mu(2, 2);
   mu << 0, 0, d, 0;
   Block<double> grad;
   for (int exact = 0; exact < 2; ++exact) {
-    const double value = exact ? repulsion_exact(mu, sigma, &grad) : repulsion_cutoff(mu, sigma, &grad);
+    const double value =
+        exact ? repulsion_exact(mu, sigma, &grad) : repulsion_cutoff(mu, sigma, &grad);
     CHECK(value == Approx(0.25 * (2 + 2 * e)).epsilon(1e-14));
     CHECK(grad(0, 0) == Approx(e / (2 * sigma)).epsilon(1e-14));
     CHECK(grad(0, 1) == 0);
@@ -157,7 +158,8 @@ TEST_CASE("repulsion timing at K = 10^4", "[.bench][repulsion]") {
     for (int r = 0; r < 15; ++r) {
       const auto t0 = std::chrono::steady_clock::now();
       f();
-      ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      ms.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     }
     std::sort(ms.begin(), ms.end());
     return ms[ms.size() / 2];
@@ -166,7 +168,10 @@ TEST_CASE("repulsion timing at K = 10^4", "[.bench][repulsion]") {
   const double ms_d = median_ms([&] { repulsion_cutoff(mu, 0.01, &grad); });
   const auto t0 = std::chrono::steady_clock::now();
   repulsion_exact(mu, 0.01, &exact_grad);
-  const double ms_exact = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("repulsion K = 10^4, sigma = 0.01, %d threads, median of 15: float %.2f ms, double %.2f ms"
-              " (exact oracle, 1 thread, %.0f ms)\n", max_threads(), ms_f, ms_d, ms_exact);
+  const double ms_exact =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  std::printf(
+      "repulsion K = 10^4, sigma = 0.01, %d threads, median of 15: float %.2f ms, double %.2f ms"
+      " (exact oracle, 1 thread, %.0f ms)\n",
+      max_threads(), ms_f, ms_d, ms_exact);
 }
