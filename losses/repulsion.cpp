@@ -115,6 +115,7 @@ double repulsion_cutoff(const Block<T>& mu, T sigma, Block<T>* dmu, const Repuls
             "repulsion: mu is " << mu.rows() << " x " << mu.cols() << ", not K x 2");
   JSA_CHECK(sigma > 0, "repulsion: sigma = " << sigma);
   JSA_CHECK(o.tolerance > 0 && o.tolerance < 1, "repulsion: tolerance = " << o.tolerance);
+  JSA_CHECK(mu.allFinite(), "repulsion: a mean is not finite");
   const Index K = mu.rows();
   if (dmu) dmu->resize(K, 2);
   if (K == 0) return 0;

@@ -76,6 +76,15 @@ TEST_CASE("repulsion of two points by hand", "[repulsion]") {
   }
 }
 
+TEST_CASE("repulsion of one mean is its own pair", "[repulsion]") {
+  Block<double> mu(1, 2), grad;
+  mu << 0.3, -2;
+  CHECK(repulsion_cutoff(mu, 0.1, &grad) == 1);
+  CHECK(grad.rows() == 1);
+  CHECK(grad.isZero(0));
+  CHECK(repulsion_exact(mu, 0.1, &grad) == 1);
+}
+
 TEST_CASE("repulsion: coincident means count exp(0) and pull nowhere", "[repulsion]") {
   Block<double> mu(3, 2);
   mu << 0.5, 0.5, 0.5, 0.5, 0.9, 0.5;  // mu_0 == mu_1
