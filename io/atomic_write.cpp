@@ -41,8 +41,8 @@ std::string create_temporary(const std::string& path) {
   pattern.push_back('\0');
   const int fd = ::mkstemp(pattern.data());
   if (fd < 0)
-    input_error(path, "", "cannot write in directory '" + directory + "' (" +
-                              std::strerror(errno) + ")");
+    input_error(path, "",
+                "cannot write in directory '" + directory + "' (" + std::strerror(errno) + ")");
   mode_t mode = 0644;
   if (::stat(path.c_str(), &info) == 0) mode = info.st_mode & 07777;
   ::fchmod(fd, mode);

@@ -15,7 +15,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 struct ProfilePoint {
-  double rho, z;          // distance from the z axis, height
+  double rho, z;                // distance from the z axis, height
   double normal_rho, normal_z;  // unit outward normal in the (rho, z) plane
 };
 
@@ -62,8 +62,8 @@ std::vector<int> add_ring(MeshBuilder& builder, const ProfilePoint& p, int aroun
 }
 
 // Triangles between ring `low` and the ring `high` above it on the profile.
-void connect_rings(MeshBuilder& builder, const std::vector<int>& low,
-                   const std::vector<int>& high, int around) {
+void connect_rings(MeshBuilder& builder, const std::vector<int>& low, const std::vector<int>& high,
+                   int around) {
   for (int j = 0; j < around; ++j) {
     const int k = (j + 1) % around;
     if (low.size() == 1) {

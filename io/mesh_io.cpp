@@ -44,14 +44,14 @@ void write_obj(const std::string& path, const Mesh& mesh, const Block<double>* u
     out << "# jsatlas: " << count << " vertices, " << mesh.faces.rows() << " faces\n";
     if (!mtl_file.empty()) out << "mtllib " << mtl_file << "\n";
     for (Index v = 0; v < count; ++v)
-      out << "v " << mesh.vertices(v, 0) << " " << mesh.vertices(v, 1) << " "
-          << mesh.vertices(v, 2) << "\n";
+      out << "v " << mesh.vertices(v, 0) << " " << mesh.vertices(v, 1) << " " << mesh.vertices(v, 2)
+          << "\n";
     if (uv)
       for (Index v = 0; v < count; ++v) out << "vt " << (*uv)(v, 0) << " " << (*uv)(v, 1) << "\n";
     if (mesh.has_normals())
       for (Index v = 0; v < count; ++v)
-        out << "vn " << mesh.normals(v, 0) << " " << mesh.normals(v, 1) << " "
-            << mesh.normals(v, 2) << "\n";
+        out << "vn " << mesh.normals(v, 0) << " " << mesh.normals(v, 1) << " " << mesh.normals(v, 2)
+            << "\n";
     if (!material.empty()) out << "usemtl " << material << "\n";
     for (Index f = 0; f < mesh.faces.rows(); ++f) {
       out << "f";

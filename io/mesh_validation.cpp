@@ -124,8 +124,9 @@ void validate_mesh(const std::string& path, Mesh& mesh) {
   if (mesh.faces.rows() > 0) {
     const Block<double> unit = face_normals(mesh.vertices, mesh.faces);
     if (unit.rowwise().squaredNorm().maxCoeff() == 0)
-      input_error(path, "", "all " + std::to_string(mesh.faces.rows()) +
-                                " faces are degenerate (zero area); nothing to sample");
+      input_error(path, "",
+                  "all " + std::to_string(mesh.faces.rows()) +
+                      " faces are degenerate (zero area); nothing to sample");
     add_topology_warnings(mesh, unit);
   }
   if (mesh.has_normals()) normalize_normals(path, mesh);

@@ -10,7 +10,7 @@ namespace jsa {
 
 struct Normalization {
   Eigen::RowVector3d center = Eigen::RowVector3d::Zero();  // mean of the points
-  double scale = 1;  // max distance from center; > 0
+  double scale = 1;                                        // max distance from center; > 0
 
   Block<double> to_unit(const Block<double>& points) const;    // (p - center) / scale
   Block<double> from_unit(const Block<double>& points) const;  // p * scale + center

@@ -34,7 +34,8 @@ void gather_faces(const tinyobj::ObjReader& reader, Mesh& mesh) {
         continue;
       normal_sums.row(corner.vertex_index) +=
           Eigen::RowVector3d(attrib.normals[3 * n], attrib.normals[3 * n + 1],
-                             attrib.normals[3 * n + 2]).normalized();
+                             attrib.normals[3 * n + 2])
+              .normalized();
     }
   mesh.faces = Eigen::Map<const Faces>(corners.data(), Index(corners.size() / 3), 3);
   if (with_normals && mesh.faces.rows() > 0) mesh.normals = normal_sums;
@@ -55,9 +56,9 @@ Mesh read_obj(const std::string& path) {
 
   const tinyobj::attrib_t& attrib = reader.GetAttrib();
   Mesh mesh;
-  mesh.vertices = Eigen::Map<const ObjRows>(attrib.vertices.data(),
-                                                  Index(attrib.vertices.size() / 3), 3)
-                      .cast<double>();
+  mesh.vertices =
+      Eigen::Map<const ObjRows>(attrib.vertices.data(), Index(attrib.vertices.size() / 3), 3)
+          .cast<double>();
   mesh.normals.resize(0, 3);
   gather_faces(reader, mesh);
   if (mesh.faces.rows() == 0 && !attrib.normals.empty()) {
@@ -66,9 +67,9 @@ Mesh read_obj(const std::string& path) {
                   "point cloud has " + std::to_string(attrib.vertices.size() / 3) +
                       " 'v' lines but " + std::to_string(attrib.normals.size() / 3) +
                       " 'vn' lines; expected one normal per point");
-    mesh.normals = Eigen::Map<const ObjRows>(attrib.normals.data(),
-                                                   Index(attrib.normals.size() / 3), 3)
-                       .cast<double>();
+    mesh.normals =
+        Eigen::Map<const ObjRows>(attrib.normals.data(), Index(attrib.normals.size() / 3), 3)
+            .cast<double>();
   }
   std::istringstream warnings(reader.Warning());
   for (std::string line; std::getline(warnings, line);)

@@ -24,9 +24,9 @@ struct PlyType {
 
 struct PlyProperty {
   std::string name;
-  PlyType type;           // the value type (the item type for a list)
+  PlyType type;  // the value type (the item type for a list)
   bool is_list = false;
-  PlyType count_type;     // lists only
+  PlyType count_type;  // lists only
 };
 
 struct PlyElement {
@@ -39,17 +39,17 @@ struct PlyElement {
 struct PlyHeader {
   PlyFormat format = PlyFormat::ascii;
   std::vector<PlyElement> elements;
-  std::size_t body_offset = 0;      // first byte after "end_header\n"
+  std::size_t body_offset = 0;       // first byte after "end_header\n"
   std::int64_t body_first_line = 0;  // its line number (ascii)
 };
 
 bool type_named(const std::string& name, PlyType& type) {
   static const std::map<std::string, PlyType> types = {
-      {"char", {1, false, true}},   {"int8", {1, false, true}},    {"uchar", {1, false, false}},
-      {"uint8", {1, false, false}}, {"short", {2, false, true}},   {"int16", {2, false, true}},
+      {"char", {1, false, true}},    {"int8", {1, false, true}},    {"uchar", {1, false, false}},
+      {"uint8", {1, false, false}},  {"short", {2, false, true}},   {"int16", {2, false, true}},
       {"ushort", {2, false, false}}, {"uint16", {2, false, false}}, {"int", {4, false, true}},
-      {"int32", {4, false, true}},  {"uint", {4, false, false}},   {"uint32", {4, false, false}},
-      {"float", {4, true, true}},   {"float32", {4, true, true}},  {"double", {8, true, true}},
+      {"int32", {4, false, true}},   {"uint", {4, false, false}},   {"uint32", {4, false, false}},
+      {"float", {4, true, true}},    {"float32", {4, true, true}},  {"double", {8, true, true}},
       {"float64", {8, true, true}}};
   const auto found = types.find(name);
   if (found == types.end()) return false;
@@ -134,8 +134,7 @@ PlyHeader read_header(const std::string& path, const std::string& bytes) {
     } else if (key == "property") {
       read_property_line(path, line, header);
     } else {
-      input_error(path, line_label(number),
-                  "unexpected header keyword '" + std::string(key) + "'");
+      input_error(path, line_label(number), "unexpected header keyword '" + std::string(key) + "'");
     }
   }
   if (!has_format) input_error(path, "header", "no 'format' line");
@@ -144,8 +143,7 @@ PlyHeader read_header(const std::string& path, const std::string& bytes) {
 
 // The fewest body bytes the declared elements could occupy: binary rows have a
 // fixed part plus one count per list; an ascii value takes at least 2 characters.
-void check_declared_sizes(const std::string& path, const PlyHeader& header,
-                          std::size_t file_size) {
+void check_declared_sizes(const std::string& path, const PlyHeader& header, std::size_t file_size) {
   const double available = double(file_size - header.body_offset);
   double least = 0;
   for (const PlyElement& element : header.elements) {
@@ -168,7 +166,10 @@ void check_declared_sizes(const std::string& path, const PlyHeader& header,
 class PlyBody {
  public:
   PlyBody(const std::string& path, const std::string& bytes, const PlyHeader& header)
-      : path_(path), bytes_(bytes), format_(header.format), pos_(header.body_offset),
+      : path_(path),
+        bytes_(bytes),
+        format_(header.format),
+        pos_(header.body_offset),
         lines_(bytes, header.body_offset, header.body_first_line) {
     const std::uint16_t probe = 1;
     unsigned char first;
@@ -182,8 +183,8 @@ class PlyBody {
     row_ = row;
     if (format_ != PlyFormat::ascii) return;
     if (!lines_.next(line_))
-      fail("", "file ends early: expected " + std::to_string(element.count) + " '" +
-                   element.name + "' rows, found " + std::to_string(row));
+      fail("", "file ends early: expected " + std::to_string(element.count) + " '" + element.name +
+                   "' rows, found " + std::to_string(row));
     token_ = 0;
   }
 
@@ -203,8 +204,7 @@ class PlyBody {
 
   [[noreturn]] void fail(const std::string& field, const std::string& what) const {
     std::string where;
-    if (format_ == PlyFormat::ascii)
-      where = line_label(line_.number) + " (";
+    if (format_ == PlyFormat::ascii) where = line_label(line_.number) + " (";
     where += "element '" + element_->name + "' row " + std::to_string(row_);
     if (!field.empty()) where += " field '" + field + "'";
     if (format_ == PlyFormat::ascii) where += ")";
@@ -265,8 +265,7 @@ int find_property(const PlyElement& element, const std::string& name) {
   return -1;
 }
 
-void read_vertices(const std::string& path, const PlyElement& element, PlyBody& body,
-                   Mesh& mesh) {
+void read_vertices(const std::string& path, const PlyElement& element, PlyBody& body, Mesh& mesh) {
   int slot[6];
   const char* names[6] = {"x", "y", "z", "nx", "ny", "nz"};
   for (int c = 0; c < 6; ++c) slot[c] = find_property(element, names[c]);
@@ -321,9 +320,8 @@ void read_faces(const std::string& path, const PlyElement& element, PlyBody& bod
         if (int(p) != slot) continue;
         const double limit = vertex_count >= 0 ? double(vertex_count) : 2147483647.0;
         if (index < 0 || index != std::floor(index) || index >= limit)
-          body.fail(property.name, "vertex index " + shown(index) +
-                                       " is out of range [0, " + std::to_string(vertex_count) +
-                                       ")");
+          body.fail(property.name, "vertex index " + shown(index) + " is out of range [0, " +
+                                       std::to_string(vertex_count) + ")");
         polygon.push_back(int(index));
       }
       for (std::size_t k = 1; k + 1 < polygon.size(); ++k)
@@ -348,8 +346,7 @@ Mesh read_ply(const std::string& path) {
   const std::string bytes = read_input_file(path);
   const PlyHeader header = read_header(path, bytes);
   check_declared_sizes(path, header, bytes.size());
-  if (header.format == PlyFormat::ascii)
-    reject_binary_bytes(path, bytes);
+  if (header.format == PlyFormat::ascii) reject_binary_bytes(path, bytes);
 
   Mesh mesh;
   mesh.vertices.resize(0, 3);

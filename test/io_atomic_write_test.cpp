@@ -45,8 +45,7 @@ TEST_CASE("write_file_atomically creates and replaces files", "[io][atomic_write
         std::filesystem::perms::none);
 }
 
-TEST_CASE("a throwing writer leaves the old file intact and no temporary",
-          "[io][atomic_write]") {
+TEST_CASE("a throwing writer leaves the old file intact and no temporary", "[io][atomic_write]") {
   ScratchDir dir;
   const std::string path = dir.path + "/keep.txt";
   jsa::write_file_atomically(path, [](std::ostream& out) { out << "precious"; });
@@ -75,8 +74,8 @@ TEST_CASE("unwritable targets are InputErrors naming the path", "[io][atomic_wri
   if (::geteuid() != 0) {  // root ignores permission bits
     const std::string locked = dir.path + "/locked";
     std::filesystem::create_directory(locked);
-    std::filesystem::permissions(locked, std::filesystem::perms::owner_read |
-                                             std::filesystem::perms::owner_exec);
+    std::filesystem::permissions(
+        locked, std::filesystem::perms::owner_read | std::filesystem::perms::owner_exec);
     CHECK_THROWS_AS(
         jsa::write_file_atomically(locked + "/out.txt", [](std::ostream& out) { out << "x"; }),
         jsa::InputError);

@@ -88,7 +88,8 @@ TEST_CASE("the cube's faces are grids on the unit cube with exact face normals",
 }
 
 TEST_CASE("resolution changes the tessellation", "[io][builtin_shapes]") {
-  CHECK(jsa::builtin_shape("sphere", 16).faces.rows() < jsa::builtin_shape("sphere", 32).faces.rows());
+  CHECK(jsa::builtin_shape("sphere", 16).faces.rows() <
+        jsa::builtin_shape("sphere", 32).faces.rows());
   CHECK_THROWS_AS(jsa::builtin_shape("sphere", 4), jsa::InputError);
 }
 

@@ -63,8 +63,8 @@ TEST_CASE("read_input_file rejects missing, directory and empty paths, naming th
 
 TEST_CASE("reject_binary_bytes names the line of the first NUL byte", "[io][input_file]") {
   CHECK_NOTHROW(jsa::reject_binary_bytes("f.off", "OFF\n1 2 3\n"));
-  const std::string m = message_of(
-      [] { jsa::reject_binary_bytes("f.off", std::string("OFF\n1 2\0 3\n", 11)); });
+  const std::string m =
+      message_of([] { jsa::reject_binary_bytes("f.off", std::string("OFF\n1 2\0 3\n", 11)); });
   CHECK(m.find("f.off:line 2: binary data") == 0);
 }
 

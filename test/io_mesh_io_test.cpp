@@ -98,8 +98,8 @@ TEST_CASE("OBJ face syntax follows what the mesh has", "[io][mesh_io]") {
 TEST_CASE("OBJ polygons are triangulated and v+vn without faces is a point cloud",
           "[io][mesh_io]") {
   ScratchDir dir;
-  const jsa::Mesh quad = jsa::read_shape(
-      dir.file("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 2\nf 1//1 2//1 3//1 4//1\n"));
+  const jsa::Mesh quad = jsa::read_shape(dir.file(
+      "quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 2\nf 1//1 2//1 3//1 4//1\n"));
   CHECK(quad.faces.rows() == 2);
   REQUIRE(quad.normals.rows() == 4);
   CHECK(quad.normals(3, 2) == Approx(1));
@@ -127,8 +127,8 @@ TEST_CASE("an oriented point cloud round-trips through OBJ v and vn lines", "[io
 TEST_CASE("OFF files are read: counts on the keyword line, NOFF normals, polygons",
           "[io][mesh_io]") {
   ScratchDir dir;
-  const jsa::Mesh square = jsa::read_shape(
-      dir.file("square.off", "OFF 4 1 0\n# a comment\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3 255 0 0\n"));
+  const jsa::Mesh square = jsa::read_shape(dir.file(
+      "square.off", "OFF 4 1 0\n# a comment\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3 255 0 0\n"));
   CHECK(square.vertices.rows() == 4);
   CHECK(square.faces.rows() == 2);
   CHECK(square.faces.row(1) == Eigen::RowVector3i(0, 2, 3));
@@ -188,7 +188,8 @@ TEST_CASE("bad OFF content is rejected with the line", "[io][mesh_io]") {
   check_rejects(dir, "huge.off", "OFF\n1000000000 1 0\n0 0 0\n",
                 "line 2: declares 1000000000 vertices");
   check_rejects(dir, "counts.off", "OFF\nthree 1 0\n", "line 2: expected the vertex count");
-  check_rejects(dir, "early.off", "OFF\n3 1 0\n0.000000 0.000000 0.000000\n1.000000 0.000000 0.000000\n",
+  check_rejects(dir, "early.off",
+                "OFF\n3 1 0\n0.000000 0.000000 0.000000\n1.000000 0.000000 0.000000\n",
                 "line 4: file ends early: expected 3 vertices, found 2");
   check_rejects(dir, "nan.off", "OFF\n3 1 0\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n",
                 "line 4: 'nan' is not a finite number");

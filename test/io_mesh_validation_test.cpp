@@ -67,8 +67,7 @@ TEST_CASE("normals are normalised and zero ones recomputed from the faces",
   CHECK(has_warning(mesh, "1 zero-length normals recomputed"));
 }
 
-TEST_CASE("invalid meshes are rejected naming the file and the element",
-          "[io][mesh_validation]") {
+TEST_CASE("invalid meshes are rejected naming the file and the element", "[io][mesh_validation]") {
   auto rejects = [](jsa::Mesh mesh, const std::string& expected) {
     const std::string m = message_of([&] { jsa::validate_mesh("bad.off", mesh); });
     INFO(m);

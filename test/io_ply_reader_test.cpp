@@ -13,6 +13,7 @@
 #include <limits>
 
 #include "engine/check.h"
+#include "engine/rng.h"
 #include "io/mesh_io.h"
 
 namespace {
@@ -61,8 +62,8 @@ bool host_is_little_endian() {
 // normals), one square base (a quad) and four triangles, plus an `edge` element
 // that the reader must skip. Corners are listed with a uchar count and int indices.
 const float kCorners[5][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5f, 0.5f, 1}};
-const int kPolygons[5][4] = {{0, 3, 2, 1}, {0, 1, 4, -1}, {1, 2, 4, -1}, {2, 3, 4, -1},
-                             {3, 0, 4, -1}};
+const int kPolygons[5][4] = {
+    {0, 3, 2, 1}, {0, 1, 4, -1}, {1, 2, 4, -1}, {2, 3, 4, -1}, {3, 0, 4, -1}};
 
 std::string pyramid_header(const std::string& format) {
   return "ply\nformat " + format +
@@ -159,8 +160,7 @@ TEST_CASE("PLY integer coordinates, uint lists and 'vertex_index' are read", "[i
   CHECK_FALSE(mesh.has_normals());
 }
 
-TEST_CASE("a PLY with vertices and normals but no faces is an oriented point cloud",
-          "[io][ply]") {
+TEST_CASE("a PLY with vertices and normals but no faces is an oriented point cloud", "[io][ply]") {
   ScratchDir dir;
   const std::string path = dir.file(
       "cloud.ply",
@@ -238,8 +238,9 @@ TEST_CASE("broken PLY files are rejected with one line naming the file and the p
     std::string bad = full;
     const std::size_t faces = full.size() - 8 - (17 + 4 * 13);  // first face row
     bad[faces + 1] = char(0xff), bad[faces + 2] = char(0xff), bad[faces + 3] = char(0xff),
-    bad[faces + 4] = char(0xff);
-    rejects("negative.ply", bad, "element 'face' row 0 field 'vertex_indices': vertex index -1 is out of range");
+                bad[faces + 4] = char(0xff);
+    rejects("negative.ply", bad,
+            "element 'face' row 0 field 'vertex_indices': vertex index -1 is out of range");
   }
   SECTION("NaN coordinate") {
     std::string bad = full;
@@ -270,4 +271,42 @@ TEST_CASE("broken PLY files are rejected with one line naming the file and the p
             "property float z\nend_header\n0 0 0\n",
             "no faces and no normals");
   }
+}
+
+TEST_CASE("corrupted PLY and OFF files only ever raise InputError", "[io][ply]") {
+  // Flip, delete or truncate bytes of valid files at random: the reader must
+  // either accept the result or throw InputError, never crash or throw anything else.
+  ScratchDir dir;
+  const std::string sources[] = {pyramid_binary(false), pyramid_binary(true), pyramid_ascii(),
+                                 "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n"};
+  const std::string names[] = {"fuzz.ply", "fuzz.ply", "fuzz.ply", "fuzz.off"};
+  jsa::Rng rng(11);
+  int rejected = 0, trials = 0;
+  for (int s = 0; s < 4; ++s)
+    for (int trial = 0; trial < 300; ++trial, ++trials) {
+      std::string bytes = sources[s];
+      const int edits = 1 + int(rng.below(3));
+      for (int e = 0; e < edits && !bytes.empty(); ++e) {
+        const std::size_t at = rng.below(bytes.size());
+        switch (rng.below(3)) {
+          case 0:
+            bytes[at] = char(rng.below(256));
+            break;
+          case 1:
+            bytes.erase(at, 1);
+            break;
+          default:
+            bytes.resize(at);
+            break;
+        }
+      }
+      const std::string path = dir.file(names[s], bytes);
+      try {
+        jsa::read_shape(path);
+      } catch (const jsa::InputError& e) {
+        ++rejected;
+        CHECK(std::string(e.what()).find(path) == 0);
+      }
+    }
+  CHECK(rejected > trials / 4);  // the corruption does get noticed
 }

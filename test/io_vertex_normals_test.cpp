@@ -27,8 +27,7 @@ TEST_CASE("vertex normals weigh each face by its area", "[io][vertex_normals]") 
   CHECK(normals.row(4) == Eigen::RowVector3d(1, 0, 0));
 }
 
-TEST_CASE("on a sphere the recomputed normals point along the position",
-          "[io][vertex_normals]") {
+TEST_CASE("on a sphere the recomputed normals point along the position", "[io][vertex_normals]") {
   const jsa::Mesh sphere = jsa::builtin_shape("sphere", 32);
   const jsa::Block<double> normals =
       jsa::area_weighted_vertex_normals(sphere.vertices, sphere.faces);
