@@ -1,0 +1,16 @@
+// Each subcommand registers itself on the CLI11 app; main() only dispatches and
+// turns every error into one line on stderr and a non-zero exit code.
+#pragma once
+#include <CLI/CLI.hpp>
+
+namespace jsa::cli {
+
+// Thrown by a command that must end with a specific exit code (e.g. 130 after
+// Ctrl-C, once the checkpoint is safe).
+struct ExitCode {
+  int code;
+};
+
+void add_fit(CLI::App& app);
+
+}  // namespace jsa::cli

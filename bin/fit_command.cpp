@@ -1,0 +1,181 @@
+// `jsatlas fit INPUT -o DIR`: learn the atlas of one shape (paper Sec. 3).
+// Writes DIR/config.json, DIR/losses.csv, DIR/model.ckpt (every
+// --checkpoint-every iterations and at the end) and DIR/domain_mesh.obj.
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "bin/commands.h"
+#include "bin/run_files.h"
+#include "engine/parallel.h"
+#include "io/atomic_write.h"
+#include "model/checkpoint.h"
+#include "model/fit_config.h"
+
+namespace jsa::cli {
+namespace {
+
+std::atomic<int> g_signal{0};
+extern "C" void on_signal(int s) { g_signal = s; }
+
+struct FitArgs {
+  std::string input, out_dir, resume;
+  FitOptions options;
+  int threads = 0;
+  int checkpoint_every = 500;
+  int table_row = 0;
+  bool no_normals = false, no_repulsion = false, no_distribution = false, no_chart = false,
+       no_isometry = false;
+  std::string preset;
+  Index pool = 200000;
+  int mesh_resolution = 256;
+  double mesh_threshold = 0.3;
+  bool quiet = false;
+};
+
+std::string format_duration(double seconds) {
+  char buf[32];
+  const int s = int(seconds + 0.5);
+  if (s >= 3600) std::snprintf(buf, sizeof buf, "%dh%02dm", s / 3600, (s / 60) % 60);
+  else std::snprintf(buf, sizeof buf, "%dm%02ds", s / 60, s % 60);
+  return buf;
+}
+
+void run_fit(FitArgs& a) {
+  namespace fs = std::filesystem;
+  FitOptions o = a.options;
+  std::string input = a.input;
+  CheckpointContents resumed;
+  const bool resuming = !a.resume.empty();
+  if (resuming) {
+    a.out_dir = a.resume;
+    resumed = read_checkpoint((fs::path(a.resume) / "model.ckpt").string());
+    o = fit_options_from_json(resumed.settings_json, a.resume + "/model.ckpt");
+    input = resumed.input;
+  } else {
+    if (input.empty()) throw InputError("fit: give an INPUT (a mesh, a point cloud or builtin:NAME) or --resume DIR");
+    if (a.out_dir.empty()) throw InputError("fit: give an output directory with -o DIR");
+    if (!a.preset.empty()) {
+      if (a.preset != "paper") throw InputError("--preset: unknown preset '" + a.preset + "' (known: paper)");
+      o.points = 10000;
+      o.atlas.gaussians = 10000;
+      o.atlas.width = 256;
+      o.atlas.hidden_layers = 5;
+    }
+    if (a.table_row) o.components = Components::table_row(a.table_row);
+    if (a.no_normals) o.components.normals = false;
+    if (a.no_repulsion) o.components.repulsion = false;
+    if (a.no_distribution) o.components.distribution = false;
+    if (a.no_chart) o.components.chart = false;
+    if (a.no_isometry) o.components.isometry = false;
+  }
+  set_threads(a.threads);
+
+  // The shape, a fixed pool of surface samples, and the unit frame (Sec. 4 data).
+  RunInput shape = load_run_input(input, a.pool, o.seed);
+  if (resuming) shape.normalization = resumed.normalization;
+  fs::create_directories(a.out_dir);
+  const std::string dir = a.out_dir;
+  write_file_atomically(dir + "/config.json", [&](std::ostream& out) {
+    out << "{\n\"input\": " << json_quote(input) << ",\n\"settings\": " << fit_options_to_json(o) << "\n}\n";
+  });
+
+  Trainer trainer(o, shape.pool);
+  LossLog log;
+  if (resuming) {
+    restore_trainer(trainer, resumed, a.resume);
+    log = read_loss_log(dir + "/losses.csv", trainer.iteration());
+  }
+  if (!a.quiet)
+    std::cerr << "fit: " << input << " -> " << dir << "  (" << o.iterations << " iterations, M = " << o.points
+              << ", K = " << o.atlas.gaussians << ", MLP " << o.atlas.hidden_layers << "x" << o.atlas.width
+              << ", " << max_threads() << " threads" << (resuming ? ", resumed at " + std::to_string(trainer.iteration()) : std::string()) << ")\n";
+
+  auto save = [&]() {
+    write_checkpoint(dir + "/model.ckpt", input, o, shape.normalization, trainer);
+    write_loss_log(dir + "/losses.csv", log);
+  };
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  using clock = std::chrono::steady_clock;
+  const auto start = clock::now();
+  auto last_print = start;
+  const int64_t first = trainer.iteration();
+  while (!trainer.finished()) {
+    trainer.step();
+    log.rows.push_back({trainer.iteration(), trainer.learning_rate(), trainer.last()});
+    const auto now = clock::now();
+    const double elapsed = std::chrono::duration<double>(now - start).count();
+    if (!a.quiet && (std::chrono::duration<double>(now - last_print).count() > 2.0 || trainer.finished())) {
+      last_print = now;
+      const double rate = double(trainer.iteration() - first) / std::max(1e-9, elapsed);
+      const LossTerms& l = trainer.last();
+      std::fprintf(stderr, "  it %6lld/%lld  %5.1f it/s  ETA %s  L %.3e  6D %.3e  2D %.3e  cyc %.2e/%.2e  iso %.3f  rep %.3e\n",
+                   (long long)trainer.iteration(), (long long)o.iterations, rate,
+                   format_duration(double(o.iterations - trainer.iteration()) / std::max(rate, 1e-9)).c_str(),
+                   l.total, l.surface, l.chart, l.cycle_2d, l.cycle_6d, l.isometry, l.repulsion);
+    }
+    if (!std::isfinite(trainer.last().total))
+      throw InputError("fit: the loss became " + std::to_string(trainer.last().total) + " at iteration " +
+                       std::to_string(trainer.iteration()) + "; last good checkpoint kept in " + dir);
+    if (a.checkpoint_every > 0 && trainer.iteration() % a.checkpoint_every == 0) save();
+    if (g_signal) {
+      save();
+      std::cerr << "fit: interrupted; checkpoint written at iteration " << trainer.iteration()
+                << " (continue with: jsatlas fit --resume " << dir << ")\n";
+      throw ExitCode{130};
+    }
+  }
+  save();
+  write_run_outputs(trainer.atlas(), shape, dir, a.mesh_resolution, a.mesh_threshold, a.quiet);
+  if (!a.quiet)
+    std::cerr << "fit: done in " << format_duration(std::chrono::duration<double>(clock::now() - start).count())
+              << "; results in " << dir << "\n";
+}
+
+}  // namespace
+
+void add_fit(CLI::App& app) {
+  auto a = std::make_shared<FitArgs>();
+  FitOptions& o = a->options;
+  CLI::App* c = app.add_subcommand("fit", "Learn the atlas of a shape: domain P, parametrization phi, chart psi");
+  c->add_option("input", a->input, "Mesh (.obj .off .ply), oriented point cloud (.ply with normals, .xyz x y z nx ny nz), or builtin:NAME (sphere, torus, cube, ...)");
+  c->add_option("-o,--out", a->out_dir, "Output directory (created if needed)");
+  c->add_option("--resume", a->resume, "Continue the run in DIR from its model.ckpt (settings come from the checkpoint)");
+  c->add_option("--iters", o.iterations, "Training iterations")->capture_default_str()->check(CLI::Range(int64_t(0), int64_t(100000000)));
+  c->add_option("--points,-M", o.points, "M: points sampled on P and on the shape per iteration")->capture_default_str()->check(CLI::Range(Index(16), Index(1000000)));
+  c->add_option("--gaussians,-K", o.atlas.gaussians, "K: Gaussians in the domain P (sigma = 1/sqrt(K))")->capture_default_str()->check(CLI::Range(1, 1000000));
+  c->add_option("--width", o.atlas.width, "Hidden units of phi and psi")->capture_default_str()->check(CLI::Range(4, 4096));
+  c->add_option("--depth", o.atlas.hidden_layers, "Hidden layers of phi and psi")->capture_default_str()->check(CLI::Range(1, 32));
+  c->add_option("--alpha", o.atlas.alpha, "Norm of the scaled normals (Eq. 2)")->capture_default_str()->check(CLI::PositiveNumber);
+  c->add_option("--lr", o.lr, "Adam learning rate")->capture_default_str()->check(CLI::PositiveNumber);
+  c->add_option("--decay", o.decay, "Learning-rate factor at each decay point")->capture_default_str()->check(CLI::Range(0.0, 1.0));
+  c->add_option("--decay-at", o.decay_at, "Fractions of --iters where the learning rate decays")->capture_default_str()->check(CLI::Range(0.0, 1.0));
+  c->add_option("--seed", o.seed, "Random seed (same seed and threads -> same run)")->capture_default_str();
+  c->add_option("--threads", a->threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
+  c->add_option("--w-6d", o.weights.surface, "lambda_6D on L_6D (Eq. 7)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  c->add_option("--w-2d", o.weights.chart, "lambda_2D on L_2D (Eq. 8)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  c->add_option("--w-cycle", o.weights.cycle, "lambda_cycle on L_cycle (Eq. 9; mean convention, = paper's 1/M on sums)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  c->add_option("--w-iso", o.weights.isometry, "lambda_iso on L_iso (Eq. 10; mean convention, = paper's 1e-4/M on sums)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  c->add_option("--w-rep", o.weights.repulsion, "lambda_rep on L_rep (Eq. 11)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  c->add_option("--table-row", a->table_row, "Ablation of the paper's Table 1: row 6..11 (11 = full method)")->check(CLI::Range(6, 11));
+  c->add_flag("--no-normals", a->no_normals, "Ablation: 3D Chamfer without normals");
+  c->add_flag("--no-repulsion", a->no_repulsion, "Ablation: no L_rep");
+  c->add_flag("--no-distribution", a->no_distribution, "Ablation: sample the Gaussian means only (a learned point set)");
+  c->add_flag("--no-chart", a->no_chart, "Ablation: no chart psi, no L_2D, no L_cycle");
+  c->add_flag("--no-isometry", a->no_isometry, "Ablation: no L_iso");
+  c->add_option("--preset", a->preset, "paper: M = K = 10^4, 5 x 256 MLPs (slow on a laptop)");
+  c->add_option("--pool", a->pool, "Surface samples drawn once from the input")->capture_default_str()->check(CLI::Range(Index(100), Index(10000000)));
+  c->add_option("--checkpoint-every", a->checkpoint_every, "Write model.ckpt every N iterations (0: only at the end)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  c->add_option("--mesh-resolution", a->mesh_resolution, "Grid cells across the domain for domain_mesh.obj")->capture_default_str()->check(CLI::Range(8, 4096));
+  c->add_option("--mesh-threshold", a->mesh_threshold, "Domain = {P >= t * median of P at the means}")->capture_default_str()->check(CLI::Range(0.0, 100.0));
+  c->add_flag("-q,--quiet", a->quiet, "No progress output");
+  c->callback([a]() { run_fit(*a); });
+}
+
+}  // namespace jsa::cli

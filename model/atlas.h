@@ -1,0 +1,40 @@
+// The atlas of one shape (or, with latent codes, of a collection): the domain
+// P (mu), the parametrization phi and the chart-mapping psi, with every
+// learnable number in one Parameters buffer.
+#pragma once
+#include <memory>
+
+#include "model/chart.h"
+#include "model/domain.h"
+#include "model/parametrize.h"
+
+namespace jsa {
+
+struct AtlasOptions {
+  int gaussians = 10000;    // K, the number of Gaussians in P (paper: 10^4)
+  int width = 256;          // hidden units of phi and psi (paper: 256)
+  int hidden_layers = 5;    // hidden layers of phi and psi (paper: 5)
+  double alpha = 0.01;      // norm of the normals fed to psi and produced by phi6 (paper: 0.01)
+  bool gaussian_noise = true;  // sample P (true) or the means alone (Table 1 rows 6-8)
+};
+
+template <class T>
+class Atlas {
+ public:
+  explicit Atlas(const AtlasOptions& options);
+  Atlas(const Atlas&) = delete;  // tape closures point into params: the atlas stays put
+  Atlas& operator=(const Atlas&) = delete;
+
+  void initialize(Rng& rng);  // mu ~ U[0,1]^2, MLPs as PyTorch's default
+
+  const AtlasOptions& options() const { return options_; }
+  Parameters<T> params;
+  Domain<T> domain;
+  Parametrization<T> phi;
+  Chart<T> psi;
+
+ private:
+  AtlasOptions options_;
+};
+
+}  // namespace jsa

@@ -1,0 +1,29 @@
+// model.ckpt: everything needed to resume a run or use its atlas.
+//   "JSATLAS-CKPT" magic, u32 format version, then length-prefixed sections:
+//   the input's description, the settings (JSON), the normalisation, the
+//   trainer state (parameters, Adam, RNG, iteration); and last a 64-bit FNV-1a
+//   checksum of all preceding bytes. Written atomically (temp, fsync, rename);
+//   a truncated or corrupted file is rejected before anything is loaded.
+#pragma once
+#include <string>
+
+#include "io/normalization.h"
+#include "model/trainer.h"
+
+namespace jsa {
+
+struct CheckpointContents {
+  std::string input;          // what was fitted: a path or "builtin:NAME"
+  std::string settings_json;  // fit_options_to_json of the run
+  Normalization normalization;
+  std::string state;          // Trainer::save_state bytes
+};
+
+void write_checkpoint(const std::string& path, const std::string& input, const FitOptions& options,
+                      const Normalization& normalization, const Trainer& trainer);
+// Reads and verifies (magic, version, sizes, checksum); throws InputError.
+CheckpointContents read_checkpoint(const std::string& path);
+// Restores a trainer built from contents.settings_json.
+void restore_trainer(Trainer& trainer, const CheckpointContents& contents, const std::string& path);
+
+}  // namespace jsa

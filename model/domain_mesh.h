@@ -1,0 +1,29 @@
+// From the learned density to a mesh (Sec. 3.2, "From probability distribution
+// to 2D continuous domain"): threshold P on a grid over the domain, triangulate
+// the cells inside, and map the vertices through phi.
+#pragma once
+#include "io/mesh.h"
+#include "model/atlas.h"
+
+namespace jsa {
+
+struct DomainMeshOptions {
+  int resolution = 256;    // grid cells along the longer side of the domain's bounding box
+  double threshold = 0.3;  // keep P(x) >= threshold * (median of P at the means)
+};
+
+struct DomainMesh {
+  Block<double> uv;                                          // V x 2 domain coordinates
+  Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor> faces;  // F x 3, counter-clockwise in uv
+  double level = 0;          // the absolute density threshold used
+  double mass_fraction = 0;  // share of P's mass inside the kept cells (grid estimate)
+  Eigen::RowVector2d lo, hi;  // the grid's bounding box (vt = (uv - lo) / (hi - lo))
+};
+
+DomainMesh mesh_domain(const Atlas<float>& atlas, const DomainMeshOptions& options);
+
+// phi at the rows of uv (V x 2), in batches: points (V x 3) and unit normals (V x 3).
+void evaluate_surface(Atlas<float>& atlas, const Block<double>& uv, Block<double>& points,
+                      Block<double>& normals);
+
+}  // namespace jsa

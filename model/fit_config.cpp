@@ -1,0 +1,83 @@
+#include "model/fit_config.h"
+
+#include <nlohmann/json.hpp>
+
+namespace jsa {
+
+using nlohmann::json;
+
+std::string fit_options_to_json(const FitOptions& o, int indent) {
+  json j;
+  j["atlas"] = {{"gaussians", o.atlas.gaussians},
+                {"width", o.atlas.width},
+                {"hidden_layers", o.atlas.hidden_layers},
+                {"alpha", o.atlas.alpha}};
+  j["weights"] = {{"surface_6d", o.weights.surface},
+                  {"chart_2d", o.weights.chart},
+                  {"cycle", o.weights.cycle},
+                  {"isometry", o.weights.isometry},
+                  {"repulsion", o.weights.repulsion},
+                  {"convention", "mean over points (paper's 1/M factors folded in)"}};
+  j["components"] = {{"normals", o.components.normals},
+                     {"repulsion", o.components.repulsion},
+                     {"distribution", o.components.distribution},
+                     {"chart", o.components.chart},
+                     {"isometry", o.components.isometry}};
+  j["iterations"] = o.iterations;
+  j["points"] = o.points;
+  j["lr"] = o.lr;
+  j["decay_at"] = o.decay_at;
+  j["decay"] = o.decay;
+  j["seed"] = o.seed;
+  j["repulsion_tolerance"] = o.repulsion_tolerance;
+  return j.dump(indent);
+}
+
+FitOptions fit_options_from_json(const std::string& text, const std::string& what) {
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const std::exception& e) {
+    throw InputError(what + ": not valid JSON (" + e.what() + ")");
+  }
+  FitOptions o;
+  auto field = [&](const json& obj, const char* path, const char* key, auto& out) {
+    if (!obj.is_object() || !obj.contains(key))
+      throw InputError(what + ": missing field '" + std::string(path) + key + "'");
+    try {
+      obj.at(key).get_to(out);
+    } catch (const std::exception&) {
+      throw InputError(what + ": field '" + std::string(path) + key + "' has the wrong type");
+    }
+  };
+  if (!j.is_object()) throw InputError(what + ": expected a JSON object");
+  const json& a = j.contains("atlas") ? j["atlas"] : json();
+  field(a, "atlas.", "gaussians", o.atlas.gaussians);
+  field(a, "atlas.", "width", o.atlas.width);
+  field(a, "atlas.", "hidden_layers", o.atlas.hidden_layers);
+  field(a, "atlas.", "alpha", o.atlas.alpha);
+  const json& w = j.contains("weights") ? j["weights"] : json();
+  field(w, "weights.", "surface_6d", o.weights.surface);
+  field(w, "weights.", "chart_2d", o.weights.chart);
+  field(w, "weights.", "cycle", o.weights.cycle);
+  field(w, "weights.", "isometry", o.weights.isometry);
+  field(w, "weights.", "repulsion", o.weights.repulsion);
+  const json& c = j.contains("components") ? j["components"] : json();
+  field(c, "components.", "normals", o.components.normals);
+  field(c, "components.", "repulsion", o.components.repulsion);
+  field(c, "components.", "distribution", o.components.distribution);
+  field(c, "components.", "chart", o.components.chart);
+  field(c, "components.", "isometry", o.components.isometry);
+  field(j, "", "iterations", o.iterations);
+  field(j, "", "points", o.points);
+  field(j, "", "lr", o.lr);
+  field(j, "", "decay_at", o.decay_at);
+  field(j, "", "decay", o.decay);
+  field(j, "", "seed", o.seed);
+  field(j, "", "repulsion_tolerance", o.repulsion_tolerance);
+  if (o.atlas.gaussians <= 0 || o.atlas.width <= 0 || o.atlas.hidden_layers < 0 || o.points <= 0)
+    throw InputError(what + ": sizes must be positive");
+  return o;
+}
+
+}  // namespace jsa

@@ -1,0 +1,60 @@
+#include "model/mlp.h"
+
+#include <cmath>
+
+#include "engine/ops.h"
+
+namespace jsa {
+
+template <class T>
+Mlp<T>::Mlp(Parameters<T>& params, const std::string& name, const MlpShape& shape) : shape_(shape) {
+  JSA_CHECK(shape.in > 0 && shape.out > 0 && shape.width > 0 && shape.hidden_layers >= 0, "bad MLP shape");
+  int in = shape.in;
+  for (int k = 0; k <= shape.hidden_layers; ++k) {
+    const int out = k == shape.hidden_layers ? shape.out : shape.width;
+    weight_.push_back(params.add(name + ".w" + std::to_string(k), in, out));
+    bias_.push_back(params.add(name + ".b" + std::to_string(k), 1, out));
+    in = out;
+  }
+}
+
+template <class T>
+void Mlp<T>::initialize(Parameters<T>& params, Rng& rng) const {
+  for (size_t k = 0; k < weight_.size(); ++k) {
+    auto w = params.value(weight_[k]);
+    auto b = params.value(bias_[k]);
+    const double bound = 1.0 / std::sqrt(double(w.rows()));
+    for (Index i = 0; i < w.size(); ++i) w.data()[i] = T(rng.uniform(-bound, bound));
+    for (Index i = 0; i < b.size(); ++i) b.data()[i] = T(rng.uniform(-bound, bound));
+  }
+}
+
+template <class T>
+Var Mlp<T>::forward(Tape<T>& t, Parameters<T>& params, Var x, Index value_rows) const {
+  const Index rows = t.rows(x);
+  if (value_rows < 0) value_rows = rows;
+  JSA_CHECK(t.cols(x) == shape_.in, "MLP expects " << shape_.in << " input columns, got " << t.cols(x));
+  Var h = x;
+  for (size_t k = 0; k < weight_.size(); ++k) {
+    h = linear(t, h, params.on(t, weight_[k]), params.on(t, bias_[k]), value_rows);
+    if (k + 1 < weight_.size()) h = relu_masked(t, h, value_rows);
+  }
+  return h;
+}
+
+template <class T>
+double Mlp<T>::flops(Index rows) const {
+  double f = 0;
+  int in = shape_.in;
+  for (int k = 0; k <= shape_.hidden_layers; ++k) {
+    const int out = k == shape_.hidden_layers ? shape_.out : shape_.width;
+    f += 2.0 * double(rows) * in * out;
+    in = out;
+  }
+  return f;
+}
+
+template class Mlp<float>;
+template class Mlp<double>;
+
+}  // namespace jsa

@@ -1,0 +1,45 @@
+// A multi-layer perceptron: `hidden_layers` ReLU layers of `width`, then a
+// linear output layer. The paper uses 5 hidden layers of 256 for both phi and
+// psi, no batch norm (Sec. 3, implementation details).
+//
+// forward() runs on plain rows (N x in) or on stacked-tangent rows (3N x in,
+// see engine/tangents.h): with value_rows = N the bias goes to the first N rows
+// only and every ReLU takes its mask from them, so each layer is one GEMM that
+// carries the value and both Jacobian columns at once.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "engine/parameters.h"
+#include "engine/rng.h"
+#include "engine/tape.h"
+
+namespace jsa {
+
+struct MlpShape {
+  int in = 2;             // input features
+  int out = 3;            // output features
+  int width = 256;        // units per hidden layer
+  int hidden_layers = 5;  // ReLU layers before the linear output layer
+};
+
+template <class T>
+class Mlp {
+ public:
+  Mlp() = default;
+  // Registers the weights "<name>.w<k>" (in x out) and biases "<name>.b<k>" (1 x out).
+  Mlp(Parameters<T>& params, const std::string& name, const MlpShape& shape);
+  // PyTorch's nn.Linear default, as the authors' code used: W, b ~ U(-1/sqrt(in), 1/sqrt(in)).
+  void initialize(Parameters<T>& params, Rng& rng) const;
+  // y = f(x). value_rows < 0: plain rows. value_rows = N: x is [value; tangents...].
+  Var forward(Tape<T>& t, Parameters<T>& params, Var x, Index value_rows = -1) const;
+  const MlpShape& shape() const { return shape_; }
+  // Multiply-adds of one forward pass over `rows` rows (for GFLOP/s reports).
+  double flops(Index rows) const;
+
+ private:
+  MlpShape shape_;
+  std::vector<int> weight_, bias_;  // parameter indices per layer
+};
+
+}  // namespace jsa

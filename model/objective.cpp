@@ -1,0 +1,92 @@
+#include "model/objective.h"
+
+#include "engine/ops.h"
+#include "losses/chamfer.h"
+#include "losses/cycle.h"
+#include "losses/isometry.h"
+#include "losses/repulsion.h"
+
+namespace jsa {
+
+Components Components::table_row(int row) {
+  JSA_CHECK(row >= 6 && row <= 11, "Table 1 rows 6-11 only, got " << row);
+  Components c;
+  c.normals = row >= 7;
+  c.repulsion = row >= 8;
+  c.distribution = row >= 9;
+  c.chart = row >= 10;
+  c.isometry = row >= 11;
+  return c;
+}
+
+template <class T>
+Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, const Block<T>& targets, Index m, Rng& rng,
+                           const LossWeights& w, const Components& c, LossTerms* terms) {
+  JSA_CHECK(targets.cols() == 6, "targets must be M x 6 [x_S, alpha n_S]");
+  Parameters<T>& p = atlas.params;
+  LossTerms out;
+  std::vector<std::pair<double, Var>> weighted;  // (lambda, term)
+
+  // {x_P} ~ P by the reparameterization trick (Eq. 4).
+  const Var x_p = atlas.domain.sample(t, p, m, rng);  // M x 2
+  const Var s6 = t.constant(targets);
+  const bool jacobian = c.normals || c.isometry || c.chart;
+
+  // psi({x_S, n_S}) first: the 6D cycle evaluates phi at these 2D points, and
+  // batching them with x_P makes phi one pass over 2M points.
+  Var u_s;
+  if (c.chart) u_s = atlas.psi.evaluate(t, p, s6);
+  const Var phi_in = c.chart ? concat_rows(t, {x_p, u_s}) : x_p;
+  SurfacePoints all = atlas.phi.evaluate(t, p, phi_in, jacobian);
+  auto first_m = [&](Var v) { return c.chart ? slice_rows(t, v, 0, m) : v; };
+  auto last_m = [&](Var v) { return slice_rows(t, v, m, targets.rows()); };
+
+  // L_6D = Chamfer(phi6({x_P}), {x_S, n_S})   (Eq. 7); row 6: 3D points only.
+  const Var surface = c.normals ? chamfer(t, first_m(all.phi6), s6)
+                                : chamfer(t, first_m(all.points), slice_cols(t, s6, 0, 3));
+  weighted.push_back({w.surface, surface});
+  out.surface = double(t.scalar(surface));
+
+  if (c.chart) {
+    // L_2D = Chamfer(psi({x_S, n_S}), {x_P})   (Eq. 8)
+    const Var chart = chamfer(t, u_s, x_p);
+    weighted.push_back({w.chart, chart});
+    out.chart = double(t.scalar(chart));
+    // L_cycle (Eq. 9): 2D -> 6D -> 2D on {x_P}, and 6D -> 2D -> 6D on {x_S, n_S}.
+    const Var back_2d = atlas.psi.evaluate(t, p, first_m(all.phi6));
+    const Var cycle_2d = mean_squared_distance(t, x_p, back_2d);
+    const Var cycle_6d = mean_squared_distance(t, s6, last_m(all.phi6));
+    weighted.push_back({w.cycle, cycle_2d});
+    weighted.push_back({w.cycle, cycle_6d});
+    out.cycle_2d = double(t.scalar(cycle_2d));
+    out.cycle_6d = double(t.scalar(cycle_6d));
+  }
+  if (c.isometry) {
+    // L_iso on the Jacobian at {x_P}   (Eq. 10)
+    const Var iso = isometry_loss(t, first_m(all.du), first_m(all.dv));
+    weighted.push_back({w.isometry, iso});
+    out.isometry = double(t.scalar(iso));
+  }
+  if (c.repulsion) {
+    // L_rep on the means   (Eq. 11)
+    const Var rep = repulsion(t, p.on(t, atlas.domain.means()), atlas.domain.sigma());
+    weighted.push_back({w.repulsion, rep});
+    out.repulsion = double(t.scalar(rep));
+  }
+
+  // L_single = sum of lambda * L   (Eq. 5)
+  Var total = scale(t, weighted[0].second, T(weighted[0].first));
+  for (size_t k = 1; k < weighted.size(); ++k)
+    total = add(t, total, scale(t, weighted[k].second, T(weighted[k].first)));
+  out.total = double(t.scalar(total));
+  if (terms) *terms = out;
+  return total;
+}
+
+template Var single_shape_objective<float>(Tape<float>&, Atlas<float>&, const Block<float>&, Index,
+                                           Rng&, const LossWeights&, const Components&, LossTerms*);
+template Var single_shape_objective<double>(Tape<double>&, Atlas<double>&, const Block<double>&,
+                                            Index, Rng&, const LossWeights&, const Components&,
+                                            LossTerms*);
+
+}  // namespace jsa

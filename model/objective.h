@@ -1,0 +1,46 @@
+// L_single, Eq. (5): the weighted sum of the five terms for one shape,
+//   l_6D L_6D + l_2D L_2D + l_cycle L_cycle + l_iso L_iso + l_rep L_rep,
+// built on the tape for one iteration, with the switches of the paper's
+// ablation (Table 1 rows 6-11).
+//
+// Convention: every term is a MEAN over its points (as Eqs. 6-10 write them),
+// so the weights are l_6D = 1, l_2D = 1e-2, l_cycle = 1, l_iso = 1e-4, l_rep = 1.
+// The paper's l_cycle = 1/M and l_iso = 1e-4/M are the same weights for losses
+// written as sums over the M points (the authors' code); see docs/method.md.
+#pragma once
+#include "model/atlas.h"
+
+namespace jsa {
+
+struct LossWeights {
+  double surface = 1.0;     // l_6D, on L_6D (Eq. 7)
+  double chart = 1e-2;      // l_2D, on L_2D (Eq. 8)
+  double cycle = 1.0;       // l_cycle, on L_cycle (Eq. 9), mean convention
+  double isometry = 1e-4;   // l_iso, on L_iso (Eq. 10), mean convention
+  double repulsion = 1.0;   // l_rep, on L_rep (Eq. 11)
+};
+
+// Which parts of the method are on. The default is Table 1 row 11, the full method.
+struct Components {
+  bool normals = true;       // n in phi6 and in the Chamfer (row 7)
+  bool repulsion = true;     // L_rep (row 8)
+  bool distribution = true;  // sample P rather than the means alone (row 9)
+  bool chart = true;         // psi with L_2D and L_cycle (row 10)
+  bool isometry = true;      // L_iso (row 11)
+  // Table 1 row 6..11 (row 6: phi on learned points, 3D Chamfer only).
+  static Components table_row(int row);
+};
+
+// The value of each term at the last evaluation (unweighted), and the total.
+struct LossTerms {
+  double total = 0, surface = 0, chart = 0, cycle_2d = 0, cycle_6d = 0, isometry = 0,
+         repulsion = 0;
+};
+
+// Builds L_single on the tape and returns it (1 x 1). targets: M x 6 rows
+// [x_S, alpha n_S] sampled on the shape; `samples` 2D points are drawn from P.
+template <class T>
+Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, const Block<T>& targets, Index samples,
+                           Rng& rng, const LossWeights& w, const Components& c, LossTerms* terms);
+
+}  // namespace jsa

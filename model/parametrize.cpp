@@ -1,0 +1,32 @@
+#include "model/parametrize.h"
+
+#include "engine/ops.h"
+#include "engine/tangents.h"
+
+namespace jsa {
+
+template <class T>
+SurfacePoints Parametrization<T>::evaluate(Tape<T>& t, Parameters<T>& params, Var x,
+                                           bool with_jacobian) const {
+  SurfacePoints s;
+  if (!with_jacobian) {
+    s.points = mlp_.forward(t, params, x);
+    return s;
+  }
+  // [x; e_u; e_v] -> [phi(x); J_u; J_v]: one pass, 3M rows (Eq. 1).
+  const Index m = t.rows(x);
+  Stacked y = unstack(t, mlp_.forward(t, params, stack_tangents(t, x), m));
+  s.points = y.value;
+  s.du = y.du;
+  s.dv = y.dv;
+  // n = alpha (J_u x J_v) / |J_u x J_v|   (Eq. 2)
+  s.normals = scale(t, row_normalize(t, cross3(t, s.du, s.dv)), alpha_);
+  // phi6(x) = [phi(x), n]   (Eq. 3)
+  s.phi6 = concat_cols(t, {s.points, s.normals});
+  return s;
+}
+
+template class Parametrization<float>;
+template class Parametrization<double>;
+
+}  // namespace jsa

@@ -1,0 +1,84 @@
+#include "model/trainer.h"
+
+#include <array>
+#include <cmath>
+#include <istream>
+#include <ostream>
+
+namespace jsa {
+
+Trainer::Trainer(const FitOptions& o, const Block<double>& pool) : options_(o), rng_(o.seed, 0) {
+  JSA_CHECK(pool.cols() == 6 && pool.rows() > 0, "the target pool must be P x 6");
+  if (o.points <= 0) throw InputError("--points must be positive");
+  if (o.iterations < 0) throw InputError("--iters must be >= 0");
+  pool_ = pool.cast<float>();
+  pool_.rightCols(3) *= float(o.atlas.alpha);
+  AtlasOptions ao = o.atlas;
+  ao.gaussian_noise = o.components.distribution;
+  atlas_ = std::make_unique<Atlas<float>>(ao);
+  Rng init(o.seed, 1);
+  atlas_->initialize(init);
+  targets_.resize(o.points, 6);
+}
+
+double Trainer::learning_rate() const {
+  std::vector<int64_t> milestones;
+  for (double f : options_.decay_at) milestones.push_back(int64_t(std::llround(f * double(options_.iterations))));
+  return step_decay(options_.lr, iteration_, milestones, options_.decay);
+}
+
+void Trainer::step() {
+  // M targets {x_S, n_S}, drawn with replacement from the pool.
+  for (Index m = 0; m < options_.points; ++m)
+    targets_.row(m) = pool_.row(Index(rng_.below(uint64_t(pool_.rows()))));
+  tape_.clear();
+  Var loss = single_shape_objective(tape_, *atlas_, targets_, options_.points, rng_, options_.weights,
+                                    options_.components, &last_);
+  atlas_->params.zero_grad();
+  tape_.backward(loss);
+  adam_.step(atlas_->params, learning_rate());
+  ++iteration_;
+}
+
+// Layout: i64 iteration, 4 x u64 RNG state, i64 Adam steps, parameters,
+// then Adam's two moment vectors (u64 length + floats each).
+void Trainer::save_state(std::ostream& out) const {
+  auto put = [&](const void* p, size_t n) { out.write(static_cast<const char*>(p), std::streamsize(n)); };
+  put(&iteration_, sizeof iteration_);
+  const auto s = rng_.state();
+  put(s.data(), sizeof(uint64_t) * 4);
+  const int64_t steps = adam_.steps();
+  put(&steps, sizeof steps);
+  atlas_->params.save(out);
+  for (const std::vector<float>* v : {&adam_.first_moment(), &adam_.second_moment()}) {
+    const uint64_t n = v->size();
+    put(&n, sizeof n);
+    put(v->data(), sizeof(float) * n);
+  }
+}
+
+void Trainer::load_state(std::istream& in, const std::string& what) {
+  auto get = [&](void* p, size_t n) {
+    in.read(static_cast<char*>(p), std::streamsize(n));
+    if (size_t(in.gcount()) != n) throw InputError(what + ": truncated training state");
+  };
+  int64_t it = 0, steps = 0;
+  std::array<uint64_t, 4> s{};
+  get(&it, sizeof it);
+  get(s.data(), sizeof(uint64_t) * 4);
+  get(&steps, sizeof steps);
+  atlas_->params.load(in, what);
+  for (std::vector<float>* v : {&adam_.first_moment(), &adam_.second_moment()}) {
+    uint64_t n = 0;
+    get(&n, sizeof n);
+    if (n != 0 && n != atlas_->params.size()) throw InputError(what + ": Adam state does not match the model");
+    v->resize(n);
+    get(v->data(), sizeof(float) * n);
+  }
+  if (it < 0 || steps < 0) throw InputError(what + ": negative iteration count");
+  iteration_ = it;
+  rng_.set_state(s);
+  adam_.set_steps(steps);
+}
+
+}  // namespace jsa

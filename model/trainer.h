@@ -1,0 +1,66 @@
+// The training loop of one atlas: draw M targets from a fixed pool of surface
+// samples, build L_single (Eq. 5) on the tape, backward, one Adam step.
+// Everything the next step depends on (parameters, Adam moments, RNG state,
+// iteration) is in the trainer, so a checkpoint resumes the same trajectory.
+// The library never prints: progress goes to a callback.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <iosfwd>
+#include <memory>
+#include <vector>
+
+#include "engine/adam.h"
+#include "model/objective.h"
+
+namespace jsa {
+
+struct FitOptions {
+  AtlasOptions atlas;          // K, network sizes, alpha
+  LossWeights weights;         // the lambdas of Eq. 5 (mean convention)
+  Components components;       // ablation switches (default: full method, row 11)
+  int64_t iterations = 3000;   // Adam steps
+  Index points = 5000;         // M: points sampled on P and on the shape per step
+  double lr = 1e-3;            // Adam learning rate
+  std::vector<double> decay_at = {0.75, 0.9};  // fractions of `iterations` where lr *= decay
+  double decay = 0.1;          // step-decay factor
+  uint64_t seed = 1;           // every random draw derives from it
+  double repulsion_tolerance = 1e-7;  // cut-off error bound of L_rep
+};
+
+struct Progress {
+  int64_t iteration = 0, iterations = 0;
+  double lr = 0;
+  LossTerms terms;
+};
+
+class Trainer {
+ public:
+  // pool: P x 6 rows [x_S, n_S] in the unit frame, n_S unit length; scaled by
+  // alpha here. The pool is drawn once; each step takes M of its rows.
+  Trainer(const FitOptions& options, const Block<double>& pool);
+  void step();
+  double learning_rate() const;  // the schedule at the current iteration
+  int64_t iteration() const { return iteration_; }
+  const LossTerms& last() const { return last_; }
+  bool finished() const { return iteration_ >= options_.iterations; }
+  Atlas<float>& atlas() { return *atlas_; }
+  const FitOptions& options() const { return options_; }
+  // The full state (parameters, Adam, RNG, iteration), for checkpoints.
+  void save_state(std::ostream& out) const;
+  void load_state(std::istream& in, const std::string& what);
+  Tape<float>& tape() { return tape_; }
+
+ private:
+  FitOptions options_;
+  Block<float> pool_;  // P x 6, normals scaled by alpha
+  std::unique_ptr<Atlas<float>> atlas_;
+  Adam<float> adam_;
+  Tape<float> tape_;
+  Rng rng_;
+  int64_t iteration_ = 0;
+  LossTerms last_;
+  Block<float> targets_;
+};
+
+}  // namespace jsa

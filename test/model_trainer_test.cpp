@@ -1,0 +1,98 @@
+// The training loop: same seed -> same run; a resumed run follows the same
+// trajectory bit for bit; and a small atlas actually learns a sphere.
+#include <catch2/catch.hpp>
+
+#include <sstream>
+
+#include "engine/parallel.h"
+#include "model/trainer.h"
+
+using namespace jsa;
+
+namespace {
+
+// P x 6 [x, n] on the unit sphere.
+Block<double> sphere_pool(Index n, uint64_t seed) {
+  Rng rng(seed);
+  Block<double> pool(n, 6);
+  for (Index i = 0; i < n; ++i) {
+    Eigen::RowVector3d p(rng.normal(), rng.normal(), rng.normal());
+    p.normalize();
+    pool.row(i) << p, p;
+  }
+  return pool;
+}
+
+FitOptions small_options() {
+  FitOptions o;
+  o.atlas.gaussians = 256;
+  o.atlas.width = 32;
+  o.atlas.hidden_layers = 3;
+  o.points = 256;
+  o.iterations = 400;
+  o.lr = 1e-3;
+  return o;
+}
+
+}  // namespace
+
+TEST_CASE("trainer: the same seed gives the same losses, bit for bit", "[trainer]") {
+  const Block<double> pool = sphere_pool(4000, 1);
+  Trainer a(small_options(), pool), b(small_options(), pool);
+  for (int i = 0; i < 5; ++i) {
+    a.step();
+    b.step();
+    REQUIRE(a.last().total == b.last().total);
+  }
+  FitOptions other = small_options();
+  other.seed = 2;
+  Trainer c(other, pool);
+  c.step();
+  CHECK(c.last().total != a.last().total);
+}
+
+TEST_CASE("trainer: a resumed run follows the uninterrupted trajectory", "[trainer]") {
+  const Block<double> pool = sphere_pool(4000, 1);
+  Trainer straight(small_options(), pool);
+  std::vector<double> expected;
+  for (int i = 0; i < 8; ++i) {
+    straight.step();
+    expected.push_back(straight.last().total);
+  }
+  Trainer first(small_options(), pool);
+  for (int i = 0; i < 4; ++i) first.step();
+  std::stringstream state;
+  first.save_state(state);
+  Trainer second(small_options(), pool);
+  second.load_state(state, "test state");
+  REQUIRE(second.iteration() == 4);
+  for (int i = 4; i < 8; ++i) {
+    second.step();
+    CHECK(second.last().total == expected[i]);
+  }
+}
+
+TEST_CASE("trainer: a truncated state is rejected", "[trainer]") {
+  const Block<double> pool = sphere_pool(1000, 1);
+  Trainer t(small_options(), pool);
+  t.step();
+  std::stringstream state;
+  t.save_state(state);
+  std::string bytes = state.str();
+  std::stringstream cut(bytes.substr(0, bytes.size() / 2));
+  Trainer u(small_options(), pool);
+  CHECK_THROWS_AS(u.load_state(cut, "cut"), InputError);
+}
+
+TEST_CASE("trainer: a small atlas learns the unit sphere", "[trainer]") {
+  const Block<double> pool = sphere_pool(20000, 3);
+  Trainer t(small_options(), pool);
+  t.step();
+  const double initial = t.last().surface;
+  while (!t.finished()) t.step();
+  const double final_6d = t.last().surface;
+  INFO("L_6D initial " << initial << ", after 400 iterations " << final_6d);
+  // Measured 0.064 (from 1.6) on this machine: the bounds leave a wide margin.
+  CHECK(final_6d < 0.1 * initial);
+  CHECK(final_6d < 0.1);
+}
