@@ -2,11 +2,11 @@
 //
 // The grid. Cells are squares of side h (r_c / 4) over the bounding box of mu,
 // numbered row-major (cell = cy * nx + cx). The means are sorted by cell with a
-// stable counting sort into structure-of-arrays copies (xs, ys). In each grid
-// row, the cells that meet the disc of radius r_c around mu_i form one
-// contiguous run of the sorted arrays, so each mean scans about nine runs with
-// branch-free, vectorised Eigen array code (sqrt, exp, sums). Pairs in those
-// runs beyond r_c are kept: they are exact terms, so keeping them only helps.
+// stable counting sort into structure-of-arrays copies (xs, ys). Each cell
+// gathers, once, the means of the cells that can hold a point within r_c of it;
+// each of its means then makes one branch-free, vectorised pass over that list
+// (Eigen arrays: sqrt, exp, sums). Gathered pairs beyond r_c are kept: they are
+// exact terms, so keeping them only helps.
 #include "losses/repulsion.h"
 
 #include <algorithm>
@@ -64,8 +64,8 @@ struct Grid {
   }
 };
 
-// Cells of side h = r_c / 4, so the cells a disc of radius r_c touches hug the
-// disc (about 4.3 r_c^2 of area scanned instead of 9 r_c^2 with h = r_c). A tiny
+// Cells of side h = r_c / 4, so a cell's candidate region hugs the disc of
+// radius r_c (about 5.7 r_c^2 of area instead of 9 r_c^2 with h = r_c). A tiny
 // r_c relative to the spread would give a huge grid of empty cells, so the cell
 // count is capped near 4 K by doubling h (any h is correct, larger just scans more).
 template <class T>
@@ -104,11 +104,14 @@ void build_grid(const Block<T>& mu, double r_c, Grid& g, std::vector<T>& xs, std
 //   row_i = sum_j w_ij,  w_ij = exp(-d_ij / sigma)
 //   g_i   = sum_j w_ij / d_ij (mu_i - mu_j)    (terms with d_ij = 0 dropped)
 //   L = 1/K^2 sum_i row_i,   dL/dmu_i = -2 / (sigma K^2) g_i
-// Neighbours: for each grid row within r_c of mu_i, the cells overlapping the
-// chord of the disc |x - mu_i| <= r_c in that row, which are one contiguous run
-// of the sorted arrays (row-major numbering). The d_ij = 0 terms need no branch:
-// they have mu_i - mu_j = 0, so w / max(d, tiny) times it is 0 (tiny = the
-// smallest normal T; only a d_ij below it would be mis-scaled).
+// Work goes cell by cell. A cell's candidates are the cells that some point of
+// it could have within r_c: in grid row ry, at vertical gap gy = (|ry - cy| - 1)+ h,
+// the columns with (|rx - cx| - 1)+ h <= sqrt(r_c^2 - gy^2). Per row those form
+// one contiguous run of the sorted arrays (row-major numbering); the runs are
+// copied once per cell into a scratch list, which each of the cell's means then
+// scans in one vectorised pass. The d_ij = 0 terms need no branch: they have
+// mu_i - mu_j = 0, so w / max(d, tiny) times it is 0 (tiny = the smallest
+// normal T; only a d_ij below it would be mis-scaled).
 template <class T>
 double repulsion_cutoff(const Block<T>& mu, T sigma, Block<T>* dmu, const RepulsionOptions& o) {
   JSA_CHECK(mu.cols() == 2,
@@ -132,46 +135,52 @@ double repulsion_cutoff(const Block<T>& mu, T sigma, Block<T>* dmu, const Repuls
   const T inv_sigma = T(1) / sigma, tiny = std::numeric_limits<T>::min();
   const double inv_k2 = 1.0 / (double(K) * double(K));
   const T grad_scale = T(-2.0 / double(sigma) * inv_k2);
+  const Index reach = Index(r_c / g.h) + 1;  // rows and columns a cell can see
   std::vector<double> rows(K);
 
 #pragma omp parallel
   {
-    Array dx, dy, d, w;  // per-thread scratch; a run uses the first n entries
-#pragma omp for schedule(dynamic, 64)
-    for (Index s = 0; s < K; ++s) {  // sorted order: neighbouring means share runs
-      const Index i = g.order[s];
-      const T xi = xs[s], yi = ys[s];
-      double row = 0;
-      T gx = 0, gy = 0;
-      const Index ry_lo = g.cell_y(double(yi) - r_c), ry_hi = g.cell_y(double(yi) + r_c);
-      for (Index ry = ry_lo; ry <= ry_hi; ++ry) {
-        const double bottom = g.y0 + double(ry) * g.h, top = bottom + g.h;
-        const double gap = std::max({0.0, bottom - double(yi), double(yi) - top});
+    // Per-thread scratch, grown when a cell needs more, never shrunk:
+    // the candidates' coordinates, then d_ij and w_ij of one mean.
+    Array cand_x, cand_y, d, w;
+#pragma omp for schedule(dynamic, 4)
+    for (Index c = 0; c < g.nx * g.ny; ++c) {
+      if (g.start[c] == g.start[c + 1]) continue;
+      const Index cx = c % g.nx, cy = c / g.nx;
+      Index n = 0;  // candidates gathered so far
+      for (Index ry = std::max<Index>(0, cy - reach); ry <= std::min(g.ny - 1, cy + reach); ++ry) {
+        const double gap = double(std::max<Index>(0, std::abs(ry - cy) - 1)) * g.h;
         if (gap > r_c) continue;
-        const double half_chord = std::sqrt(r_c * r_c - gap * gap);
-        const Index first = g.start[ry * g.nx + g.cell_x(double(xi) - half_chord)];
-        const Index last = g.start[ry * g.nx + g.cell_x(double(xi) + half_chord) + 1];
-        const Index n = last - first;
-        if (n == 0) continue;
-        if (n > dx.size()) {  // grow the scratch (rarely: it only ever grows)
-          for (Array* a : {&dx, &dy, &d, &w}) a->resize(std::max(n, 2 * a->size()));
+        // max(0, .): with gap = r_c, a fused multiply-add can leave -tiny here
+        const Index span = Index(std::sqrt(std::max(0.0, r_c * r_c - gap * gap)) / g.h) + 1;
+        const Index first = g.start[ry * g.nx + std::max<Index>(0, cx - span)];
+        const Index last = g.start[ry * g.nx + std::min(g.nx - 1, cx + span) + 1];
+        const Index m = last - first;
+        if (n + m > cand_x.size()) {
+          cand_x.conservativeResize(2 * (n + m));
+          cand_y.conservativeResize(2 * (n + m));
         }
-        auto dx_n = dx.head(n), dy_n = dy.head(n), d_n = d.head(n), w_n = w.head(n);
-        dx_n = xi - ConstMap(xs.data() + first, n);
-        dy_n = yi - ConstMap(ys.data() + first, n);
-        d_n = (dx_n * dx_n + dy_n * dy_n).sqrt();
+        cand_x.segment(n, m) = ConstMap(xs.data() + first, m);
+        cand_y.segment(n, m) = ConstMap(ys.data() + first, m);
+        n += m;
+      }
+      if (n > d.size()) {
+        d.resize(cand_x.size());
+        w.resize(cand_x.size());
+      }
+      auto d_n = d.head(n), w_n = w.head(n);
+      for (Index s = g.start[c]; s < g.start[c + 1]; ++s) {
+        const Index i = g.order[s];
+        const auto dx = xs[s] - cand_x.head(n);  // mu_i - mu_j, as expressions
+        const auto dy = ys[s] - cand_y.head(n);
+        d_n = (dx.square() + dy.square()).sqrt();
         w_n = (d_n * -inv_sigma).exp();
-        row += double(w_n.sum());
+        rows[i] = double(w_n.sum());
         if (dmu) {
           w_n /= d_n.max(tiny);  // now w_ij / d_ij
-          gx += (w_n * dx_n).sum();
-          gy += (w_n * dy_n).sum();
+          (*dmu)(i, 0) = grad_scale * (w_n * dx).sum();
+          (*dmu)(i, 1) = grad_scale * (w_n * dy).sum();
         }
-      }
-      rows[i] = row;
-      if (dmu) {
-        (*dmu)(i, 0) = grad_scale * gx;
-        (*dmu)(i, 1) = grad_scale * gy;
       }
     }
   }
