@@ -202,6 +202,13 @@ class PlyBody {
     return decode(raw, type);
   }
 
+  // The length that opens a list value; a negative one means a corrupt file.
+  double list_length(const PlyProperty& property) {
+    const double n = value(property.count_type, property.name);
+    if (n < 0) fail(property.name, "negative list length " + std::to_string(int64_t(n)));
+    return n;
+  }
+
   [[noreturn]] void fail(const std::string& field, const std::string& what) const {
     std::string where;
     if (format_ == PlyFormat::ascii) where = line_label(line_.number) + " (";
@@ -282,7 +289,7 @@ void read_vertices(const std::string& path, const PlyElement& element, PlyBody& 
     for (std::size_t p = 0; p < element.properties.size(); ++p) {
       const PlyProperty& property = element.properties[p];
       if (property.is_list) {
-        const double n = body.value(property.count_type, property.name);
+        const double n = body.list_length(property);
         for (double k = 0; k < n; ++k) body.value(property.type, property.name);
       } else {
         row[p] = body.value(property.type, property.name);
@@ -311,7 +318,7 @@ void read_faces(const std::string& path, const PlyElement& element, PlyBody& bod
         body.value(property.type, property.name);
         continue;
       }
-      const double n = body.value(property.count_type, property.name);
+      const double n = body.list_length(property);
       if (int(p) == slot && (n < 3 || n != std::floor(n)))
         body.fail(property.name, "a face needs at least 3 vertex indices, found " + shown(n));
       polygon.clear();
@@ -334,7 +341,7 @@ void skip_element(const PlyElement& element, PlyBody& body) {
   for (std::int64_t r = 0; r < element.count; ++r) {
     body.start_row(element, r);
     for (const PlyProperty& property : element.properties) {
-      const double n = property.is_list ? body.value(property.count_type, property.name) : 1;
+      const double n = property.is_list ? body.list_length(property) : 1;
       for (double k = 0; k < n; ++k) body.value(property.type, property.name);
     }
   }

@@ -249,6 +249,11 @@ TEST_CASE("broken PLY files are rejected with one line naming the file and the p
     std::memcpy(&bad[body + 4], &nan, 4);  // vertex 0, field y
     rejects("nan.ply", bad, "element 'vertex' row 0 field 'y': value is NaN or infinite");
   }
+  SECTION("negative list length") {
+    std::string bad = pyramid_ascii();
+    bad.replace(bad.find("\n3 1 2 4\n"), 9, "\n-3 1 2 4\n");
+    rejects("minus.ply", bad, "negative list length -3");
+  }
   SECTION("ascii row with too few values") {
     std::string bad = pyramid_ascii();
     bad.replace(bad.find("\n3 1 2 4\n"), 9, "\n3 1 2\n");
