@@ -45,7 +45,8 @@ void Image::set(int x, int y, const Colour& colour) {
 }
 
 Colour Image::get(int x, int y) const {
-  JSA_CHECK(contains(x, y), "pixel (" << x << ", " << y << ") outside " << width << " x " << height);
+  JSA_CHECK(contains(x, y),
+            "pixel (" << x << ", " << y << ") outside " << width << " x " << height);
   const std::uint8_t* pixel = &rgb[(static_cast<std::size_t>(y) * width + x) * 3];
   return Colour(pixel[0], pixel[1], pixel[2]) / 255.0;
 }
@@ -128,9 +129,11 @@ void fill_triangle(Image& image, const Eigen::Vector2d& a, const Eigen::Vector2d
   if (area == 0 || !std::isfinite(area)) return;
   const double sign = area > 0 ? 1 : -1;
   const int x0 = std::max(0, static_cast<int>(std::floor(std::min({a.x(), b.x(), c.x()}))));
-  const int x1 = std::min(image.width - 1, static_cast<int>(std::ceil(std::max({a.x(), b.x(), c.x()}))));
+  const int x1 =
+      std::min(image.width - 1, static_cast<int>(std::ceil(std::max({a.x(), b.x(), c.x()}))));
   const int y0 = std::max(0, static_cast<int>(std::floor(std::min({a.y(), b.y(), c.y()}))));
-  const int y1 = std::min(image.height - 1, static_cast<int>(std::ceil(std::max({a.y(), b.y(), c.y()}))));
+  const int y1 =
+      std::min(image.height - 1, static_cast<int>(std::ceil(std::max({a.y(), b.y(), c.y()}))));
   for (int y = y0; y <= y1; ++y)
     for (int x = x0; x <= x1; ++x) {
       const Eigen::Vector2d p = pixel_centre(x, y);
@@ -276,7 +279,8 @@ int draw_text(Image& image, int x, int y, const std::string& text, const Colour&
             fill_rectangle(image, x + column * scale, y + row * scale, x + (column + 1) * scale,
                            y + (row + 1) * scale, colour);
     } else {
-      draw_rectangle_outline(image, x, y, x + kGlyphWidth * scale, y + kGlyphHeight * scale, colour);
+      draw_rectangle_outline(image, x, y, x + kGlyphWidth * scale, y + kGlyphHeight * scale,
+                             colour);
     }
     x += kAdvance * scale;
   }
@@ -304,12 +308,18 @@ Colour hsv_colour(double h, double s, double v) {
   const double f = h - sector;
   const double p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
   switch (sector) {
-    case 0: return {v, t, p};
-    case 1: return {q, v, p};
-    case 2: return {p, v, t};
-    case 3: return {p, q, v};
-    case 4: return {t, p, v};
-    default: return {v, p, q};
+    case 0:
+      return {v, t, p};
+    case 1:
+      return {q, v, p};
+    case 2:
+      return {p, v, t};
+    case 3:
+      return {p, q, v};
+    case 4:
+      return {t, p, v};
+    default:
+      return {v, p, q};
   }
 }
 
