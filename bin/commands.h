@@ -12,5 +12,6 @@ struct ExitCode {
 };
 
 void add_fit(CLI::App& app);
+void add_eval(CLI::App& app);
 
 }  // namespace jsa::cli

@@ -107,7 +107,18 @@ void run_fit(FitArgs& a) {
   auto last_print = start;
   const int64_t first = trainer.iteration();
   while (!trainer.finished()) {
-    trainer.step();
+    const int64_t before = trainer.iteration();
+    try {
+      trainer.step();
+    } catch (const NumericalFault& e) {
+      save();  // the trainer is back at its last good state
+      throw InputError(std::string("fit: ") + e.what() + "; last good state saved in " + dir + "/model.ckpt");
+    }
+    if (trainer.iteration() == before) {
+      std::fprintf(stderr, "  it %6lld: NaN/Inf caught, restored the last good state, learning rate now %.2e\n",
+                   (long long)before, trainer.learning_rate());
+      continue;
+    }
     log.rows.push_back({trainer.iteration(), trainer.learning_rate(), trainer.last()});
     const auto now = clock::now();
     const double elapsed = std::chrono::duration<double>(now - start).count();
@@ -120,9 +131,6 @@ void run_fit(FitArgs& a) {
                    format_duration(double(o.iterations - trainer.iteration()) / std::max(rate, 1e-9)).c_str(),
                    l.total, l.surface, l.chart, l.cycle_2d, l.cycle_6d, l.isometry, l.repulsion);
     }
-    if (!std::isfinite(trainer.last().total))
-      throw InputError("fit: the loss became " + std::to_string(trainer.last().total) + " at iteration " +
-                       std::to_string(trainer.iteration()) + "; last good checkpoint kept in " + dir);
     if (a.checkpoint_every > 0 && trainer.iteration() % a.checkpoint_every == 0) save();
     if (g_signal) {
       save();
@@ -171,6 +179,7 @@ void add_fit(CLI::App& app) {
   c->add_flag("--no-isometry", a->no_isometry, "Ablation: no L_iso");
   c->add_option("--preset", a->preset, "paper: M = K = 10^4, 5 x 256 MLPs (slow on a laptop)");
   c->add_option("--pool", a->pool, "Surface samples drawn once from the input")->capture_default_str()->check(CLI::Range(Index(100), Index(10000000)));
+  c->add_option("--repulsion-tolerance", o.repulsion_tolerance, "Bound on the error of L_rep from its cut-off radius")->capture_default_str()->check(CLI::Range(1e-15, 1e-2));
   c->add_option("--checkpoint-every", a->checkpoint_every, "Write model.ckpt every N iterations (0: only at the end)")->capture_default_str()->check(CLI::NonNegativeNumber);
   c->add_option("--mesh-resolution", a->mesh_resolution, "Grid cells across the domain for domain_mesh.obj")->capture_default_str()->check(CLI::Range(8, 4096));
   c->add_option("--mesh-threshold", a->mesh_threshold, "Domain = {P >= t * median of P at the means}")->capture_default_str()->check(CLI::Range(0.0, 100.0));

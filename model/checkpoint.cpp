@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <memory>
 #include <sstream>
 
 #include "io/atomic_write.h"
@@ -94,6 +95,18 @@ CheckpointContents read_checkpoint(const std::string& path) {
 void restore_trainer(Trainer& trainer, const CheckpointContents& contents, const std::string& path) {
   std::istringstream state(contents.state);
   trainer.load_state(state, path);
+}
+
+std::unique_ptr<Atlas<float>> load_atlas(const CheckpointContents& contents, const std::string& path) {
+  const FitOptions o = fit_options_from_json(contents.settings_json, path);
+  AtlasOptions ao = o.atlas;
+  ao.gaussian_noise = o.components.distribution;
+  auto atlas = std::make_unique<Atlas<float>>(ao);
+  // Trainer::save_state: i64 iteration, 4 x u64 RNG, i64 Adam steps, f64 lr scale, parameters.
+  std::istringstream state(contents.state);
+  state.seekg(8 + 32 + 8 + 8);
+  atlas->params.load(state, path);
+  return atlas;
 }
 
 }  // namespace jsa

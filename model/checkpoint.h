@@ -25,5 +25,7 @@ void write_checkpoint(const std::string& path, const std::string& input, const F
 CheckpointContents read_checkpoint(const std::string& path);
 // Restores a trainer built from contents.settings_json.
 void restore_trainer(Trainer& trainer, const CheckpointContents& contents, const std::string& path);
+// The atlas alone (no optimiser), for the commands that use a finished run.
+std::unique_ptr<Atlas<float>> load_atlas(const CheckpointContents& contents, const std::string& path);
 
 }  // namespace jsa

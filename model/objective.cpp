@@ -1,5 +1,7 @@
 #include "model/objective.h"
 
+#include <limits>
+
 #include "engine/ops.h"
 #include "losses/chamfer.h"
 #include "losses/cycle.h"
@@ -21,7 +23,8 @@ Components Components::table_row(int row) {
 
 template <class T>
 Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, const Block<T>& targets, Index m, Rng& rng,
-                           const LossWeights& w, const Components& c, LossTerms* terms) {
+                           const LossWeights& w, const Components& c, LossTerms* terms,
+                           double repulsion_tolerance) {
   JSA_CHECK(targets.cols() == 6, "targets must be M x 6 [x_S, alpha n_S]");
   Parameters<T>& p = atlas.params;
   LossTerms out;
@@ -38,6 +41,14 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, const Block<T>& targets,
   if (c.chart) u_s = atlas.psi.evaluate(t, p, s6);
   const Var phi_in = c.chart ? concat_rows(t, {x_p, u_s}) : x_p;
   SurfacePoints all = atlas.phi.evaluate(t, p, phi_in, jacobian);
+  // Diverged networks: report NaN (the trainer recovers) rather than search
+  // nearest neighbours among non-finite points.
+  if (!t.value(phi_in).allFinite() || !t.value(all.points).allFinite() ||
+      (jacobian && !t.value(all.phi6).allFinite())) {
+    out.total = std::numeric_limits<double>::quiet_NaN();
+    if (terms) *terms = out;
+    return t.constant(Block<T>::Constant(1, 1, std::numeric_limits<T>::quiet_NaN()));
+  }
   auto first_m = [&](Var v) { return c.chart ? slice_rows(t, v, 0, m) : v; };
   auto last_m = [&](Var v) { return slice_rows(t, v, m, targets.rows()); };
 
@@ -69,7 +80,8 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, const Block<T>& targets,
   }
   if (c.repulsion) {
     // L_rep on the means   (Eq. 11)
-    const Var rep = repulsion(t, p.on(t, atlas.domain.means()), atlas.domain.sigma());
+    const Var rep = repulsion(t, p.on(t, atlas.domain.means()), atlas.domain.sigma(),
+                              RepulsionOptions{repulsion_tolerance});
     weighted.push_back({w.repulsion, rep});
     out.repulsion = double(t.scalar(rep));
   }
@@ -84,9 +96,10 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, const Block<T>& targets,
 }
 
 template Var single_shape_objective<float>(Tape<float>&, Atlas<float>&, const Block<float>&, Index,
-                                           Rng&, const LossWeights&, const Components&, LossTerms*);
+                                           Rng&, const LossWeights&, const Components&, LossTerms*,
+                                           double);
 template Var single_shape_objective<double>(Tape<double>&, Atlas<double>&, const Block<double>&,
                                             Index, Rng&, const LossWeights&, const Components&,
-                                            LossTerms*);
+                                            LossTerms*, double);
 
 }  // namespace jsa

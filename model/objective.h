@@ -41,6 +41,7 @@ struct LossTerms {
 // [x_S, alpha n_S] sampled on the shape; `samples` 2D points are drawn from P.
 template <class T>
 Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, const Block<T>& targets, Index samples,
-                           Rng& rng, const LossWeights& w, const Components& c, LossTerms* terms);
+                           Rng& rng, const LossWeights& w, const Components& c, LossTerms* terms,
+                           double repulsion_tolerance = 1e-7);
 
 }  // namespace jsa

@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <istream>
+#include <limits>
 #include <ostream>
 
 namespace jsa {
@@ -24,7 +25,14 @@ Trainer::Trainer(const FitOptions& o, const Block<double>& pool) : options_(o), 
 double Trainer::learning_rate() const {
   std::vector<int64_t> milestones;
   for (double f : options_.decay_at) milestones.push_back(int64_t(std::llround(f * double(options_.iterations))));
-  return step_decay(options_.lr, iteration_, milestones, options_.decay);
+  return lr_scale_ * step_decay(options_.lr, iteration_, milestones, options_.decay);
+}
+
+void Trainer::take_snapshot() {
+  good_params_ = atlas_->params.values();
+  good_m_ = adam_.first_moment();
+  good_v_ = adam_.second_moment();
+  good_steps_ = adam_.steps();
 }
 
 void Trainer::step() {
@@ -33,14 +41,38 @@ void Trainer::step() {
     targets_.row(m) = pool_.row(Index(rng_.below(uint64_t(pool_.rows()))));
   tape_.clear();
   Var loss = single_shape_objective(tape_, *atlas_, targets_, options_.points, rng_, options_.weights,
-                                    options_.components, &last_);
+                                    options_.components, &last_, options_.repulsion_tolerance);
   atlas_->params.zero_grad();
   tape_.backward(loss);
+  if (iteration_ == fault_at_ && faults_to_inject_ > 0) {
+    --faults_to_inject_;
+    last_.total = std::numeric_limits<double>::quiet_NaN();
+  }
+  bool finite = std::isfinite(last_.total);
+  for (float g : atlas_->params.grads()) finite = finite && std::isfinite(g);
+  if (!finite) {
+    // Back to the last good state with half the step; this batch is skipped.
+    ++faults_total_;
+    if (!good_params_.empty()) {
+      atlas_->params.values() = good_params_;
+      adam_.first_moment() = good_m_;
+      adam_.second_moment() = good_v_;
+      adam_.set_steps(good_steps_);
+    }
+    lr_scale_ *= 0.5;
+    if (++faults_in_a_row_ > options_.max_faults)
+      throw NumericalFault("training diverged: NaN/Inf " + std::to_string(faults_in_a_row_) +
+                           " times in a row at iteration " + std::to_string(iteration_) +
+                           " (try a smaller --lr)");
+    return;
+  }
+  faults_in_a_row_ = 0;
+  if (iteration_ % kSnapshotEvery == 0) take_snapshot();
   adam_.step(atlas_->params, learning_rate());
   ++iteration_;
 }
 
-// Layout: i64 iteration, 4 x u64 RNG state, i64 Adam steps, parameters,
+// Layout: i64 iteration, 4 x u64 RNG state, i64 Adam steps, f64 lr scale, parameters,
 // then Adam's two moment vectors (u64 length + floats each).
 void Trainer::save_state(std::ostream& out) const {
   auto put = [&](const void* p, size_t n) { out.write(static_cast<const char*>(p), std::streamsize(n)); };
@@ -49,6 +81,7 @@ void Trainer::save_state(std::ostream& out) const {
   put(s.data(), sizeof(uint64_t) * 4);
   const int64_t steps = adam_.steps();
   put(&steps, sizeof steps);
+  put(&lr_scale_, sizeof lr_scale_);
   atlas_->params.save(out);
   for (const std::vector<float>* v : {&adam_.first_moment(), &adam_.second_moment()}) {
     const uint64_t n = v->size();
@@ -67,6 +100,9 @@ void Trainer::load_state(std::istream& in, const std::string& what) {
   get(&it, sizeof it);
   get(s.data(), sizeof(uint64_t) * 4);
   get(&steps, sizeof steps);
+  double scale = 1;
+  get(&scale, sizeof scale);
+  if (!(scale > 0 && scale <= 1)) throw InputError(what + ": bad learning-rate scale");
   atlas_->params.load(in, what);
   for (std::vector<float>* v : {&adam_.first_moment(), &adam_.second_moment()}) {
     uint64_t n = 0;
@@ -79,6 +115,8 @@ void Trainer::load_state(std::istream& in, const std::string& what) {
   iteration_ = it;
   rng_.set_state(s);
   adam_.set_steps(steps);
+  lr_scale_ = scale;
+  take_snapshot();
 }
 
 }  // namespace jsa

@@ -8,6 +8,7 @@
 #include <functional>
 #include <iosfwd>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include "engine/adam.h"
@@ -26,6 +27,7 @@ struct FitOptions {
   double decay = 0.1;          // step-decay factor
   uint64_t seed = 1;           // every random draw derives from it
   double repulsion_tolerance = 1e-7;  // cut-off error bound of L_rep
+  int max_faults = 5;          // NaN/Inf recoveries in a row before giving up
 };
 
 struct Progress {
@@ -34,13 +36,27 @@ struct Progress {
   LossTerms terms;
 };
 
+// Thrown when training keeps producing NaN/Inf after max_faults recoveries.
+struct NumericalFault : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 class Trainer {
  public:
   // pool: P x 6 rows [x_S, n_S] in the unit frame, n_S unit length; scaled by
   // alpha here. The pool is drawn once; each step takes M of its rows.
   Trainer(const FitOptions& options, const Block<double>& pool);
+  // One iteration. A NaN or Inf in the loss or the gradient is caught before
+  // Adam sees it: the last good state is restored, the learning rate halved,
+  // and the batch skipped; after max_faults such steps in a row, NumericalFault.
   void step();
-  double learning_rate() const;  // the schedule at the current iteration
+  double learning_rate() const;  // the schedule at the current iteration, times the fault scale
+  int faults() const { return faults_total_; }
+  // Test hook: the next `count` attempts at `iteration` see a NaN loss.
+  void inject_faults(int64_t iteration, int count) {
+    fault_at_ = iteration;
+    faults_to_inject_ = count;
+  }
   int64_t iteration() const { return iteration_; }
   const LossTerms& last() const { return last_; }
   bool finished() const { return iteration_ >= options_.iterations; }
@@ -61,6 +77,15 @@ class Trainer {
   int64_t iteration_ = 0;
   LossTerms last_;
   Block<float> targets_;
+  // The last good state, refreshed every kSnapshotEvery iterations.
+  static constexpr int64_t kSnapshotEvery = 50;
+  std::vector<float> good_params_, good_m_, good_v_;
+  int64_t good_steps_ = 0;
+  double lr_scale_ = 1.0;
+  int faults_in_a_row_ = 0, faults_total_ = 0;
+  int64_t fault_at_ = -1;
+  int faults_to_inject_ = 0;
+  void take_snapshot();
 };
 
 }  // namespace jsa

@@ -2,6 +2,7 @@
 // trajectory bit for bit; and a small atlas actually learns a sphere.
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <sstream>
 
 #include "engine/parallel.h"
@@ -95,4 +96,36 @@ TEST_CASE("trainer: a small atlas learns the unit sphere", "[trainer]") {
   // Measured 0.064 (from 1.6) on this machine: the bounds leave a wide margin.
   CHECK(final_6d < 0.1 * initial);
   CHECK(final_6d < 0.1);
+}
+
+TEST_CASE("trainer: a NaN is caught, the last good state restored, and training goes on", "[trainer]") {
+  const Block<double> pool = sphere_pool(4000, 1);
+  Trainer t(small_options(), pool);
+  for (int i = 0; i < 3; ++i) t.step();
+  const std::vector<float> before = t.atlas().params.values();
+  const double lr_before = t.learning_rate();
+  t.inject_faults(3, 1);
+  t.step();  // the fault: nothing applied, state restored to the snapshot of iteration 0
+  CHECK(t.iteration() == 3);
+  CHECK(t.faults() == 1);
+  CHECK(t.learning_rate() == Approx(0.5 * lr_before));
+  CHECK(t.atlas().params.values() != before);  // back at the iteration-0 snapshot, not at 3
+  for (float v : t.atlas().params.values()) REQUIRE(std::isfinite(v));
+  t.step();
+  CHECK(t.iteration() == 4);
+  CHECK(std::isfinite(t.last().total));
+}
+
+TEST_CASE("trainer: repeated faults stop with NumericalFault", "[trainer]") {
+  const Block<double> pool = sphere_pool(2000, 1);
+  FitOptions o = small_options();
+  o.max_faults = 3;
+  Trainer t(o, pool);
+  t.step();
+  t.inject_faults(1, 100);
+  for (int i = 0; i < 3; ++i) t.step();  // three recoveries
+  CHECK(t.faults() == 3);
+  CHECK_THROWS_AS(t.step(), NumericalFault);  // the fourth in a row gives up
+  CHECK(t.iteration() == 1);
+  for (float v : t.atlas().params.values()) REQUIRE(std::isfinite(v));
 }

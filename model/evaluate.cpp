@@ -1,0 +1,30 @@
+#include "model/evaluate.h"
+
+#include "io/surface_sampling.h"
+#include "model/domain_mesh.h"
+
+namespace jsa {
+
+void sample_reconstruction(Atlas<float>& atlas, Index count, Rng& rng, Block<double>& uv,
+                           Block<double>& points, Block<double>& normals) {
+  Tape<float> t;
+  Var x = atlas.domain.sample(t, atlas.params, count, rng);
+  uv = t.value(x).cast<double>();
+  evaluate_surface(atlas, uv, points, normals);
+}
+
+Evaluation evaluate_reconstruction(Atlas<float>& atlas, const Mesh& shape,
+                                   const Normalization& normalization, const EvaluationOptions& o) {
+  Rng rng_p(o.seed, 10), rng_a(o.seed, 11), rng_b(o.seed, 12);
+  Block<double> uv, pp, pn;
+  sample_reconstruction(atlas, o.samples, rng_p, uv, pp, pn);
+  SurfaceSamples a = sample_surface(shape, o.samples, rng_a);
+  SurfaceSamples b = sample_surface(shape, o.samples, rng_b);
+  const Block<double> ap = normalization.to_unit(a.points), bp = normalization.to_unit(b.points);
+  Evaluation e;
+  e.fit = surface_metrics(pp, pn, ap, a.normals);
+  e.floor = surface_metrics(bp, b.normals, ap, a.normals);
+  return e;
+}
+
+}  // namespace jsa

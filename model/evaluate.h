@@ -1,0 +1,30 @@
+// Evaluating a fitted atlas against its shape (paper Sec. 4): M' fresh points
+// x ~ P mapped through phi against M' fresh samples of the shape, in the
+// shape's unit frame; and the sampling floor, the same metrics between two
+// independent samples of the shape, which is the best a perfect fit can score.
+#pragma once
+#include "io/mesh.h"
+#include "io/normalization.h"
+#include "losses/metrics.h"
+#include "model/atlas.h"
+
+namespace jsa {
+
+struct EvaluationOptions {
+  Index samples = 2000;  // M' (paper: 2000)
+  uint64_t seed = 0;     // seeds both the P draws and the surface samples
+};
+
+struct Evaluation {
+  SurfaceMetrics fit;    // atlas vs shape
+  SurfaceMetrics floor;  // shape vs an independent sample of itself
+};
+
+// `count` points of the reconstruction: uv ~ P, points = phi(uv), unit normals.
+void sample_reconstruction(Atlas<float>& atlas, Index count, Rng& rng, Block<double>& uv,
+                           Block<double>& points, Block<double>& normals);
+
+Evaluation evaluate_reconstruction(Atlas<float>& atlas, const Mesh& shape,
+                                   const Normalization& normalization, const EvaluationOptions& o);
+
+}  // namespace jsa
