@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <ostream>
+#include <utility>
 
 #include "engine/check.h"
 #include "io/atomic_write.h"
@@ -121,9 +122,14 @@ void fill_circle(Image& image, const Eigen::Vector2d& centre, double radius, con
 
 void fill_triangle(Image& image, const Eigen::Vector2d& a, const Eigen::Vector2d& b,
                    const Eigen::Vector2d& c, const Colour& colour) {
-  // Signed area of (p, q, r): positive when r is left of p->q.
+  // Signed area of (p, q, r), positive when r is left of p->q; endpoints taken in
+  // a fixed order so edge(p, q, r) == -edge(q, p, r) exactly and shared edges leave no cracks.
   auto edge = [](const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& r) {
-    return (q.x() - p.x()) * (r.y() - p.y()) - (q.y() - p.y()) * (r.x() - p.x());
+    const bool swap = std::make_pair(q.x(), q.y()) < std::make_pair(p.x(), p.y());
+    const Eigen::Vector2d& s = swap ? q : p;
+    const Eigen::Vector2d& t = swap ? p : q;
+    const double value = (t.x() - s.x()) * (r.y() - s.y()) - (t.y() - s.y()) * (r.x() - s.x());
+    return swap ? -value : value;
   };
   const double area = edge(a, b, c);
   if (area == 0 || !std::isfinite(area)) return;

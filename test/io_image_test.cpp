@@ -97,6 +97,12 @@ TEST_CASE("shapes cover the expected area", "[image]") {
   jsa::fill_triangle(image, {0, 0}, {0, 100}, {100, 0}, jsa::colours::black());  // other winding
   CHECK(count_pixels_not(image, white) == Approx(5000).epsilon(0.02));
 
+  // Two triangles sharing a diagonal through pixel centres leave no crack.
+  image.fill(white);
+  jsa::fill_triangle(image, {0, 0}, {100, 0}, {100, 100}, jsa::colours::black());
+  jsa::fill_triangle(image, {0, 0}, {100, 100}, {0, 100}, jsa::colours::black());
+  CHECK(count_pixels_not(image, white) == 100 * 100);
+
   // Coverage-weighted disc: the summed darkness is its area.
   image.fill(white);
   jsa::fill_circle(image, {50, 50}, 20, jsa::colours::black());
