@@ -64,7 +64,8 @@ void fill_triangle(Image& image, const Eigen::Vector2d& a, const Eigen::Vector2d
 // True for the characters the font has a glyph for: ' ' to '~' (all printable ASCII).
 bool font_has_glyph(char c);
 // Draws `text` with its top-left corner at (x, y). Characters without a glyph
-// draw as a hollow box. Returns the x just past the last character.
+// draw as a hollow box. g, p, q and y hang 2 rows (times scale) below the 7-row
+// text height. Returns the x just past the last character.
 int draw_text(Image& image, int x, int y, const std::string& text, const Colour& colour,
               int scale = 1);
 int text_width(const std::string& text, int scale = 1);

@@ -125,7 +125,7 @@ TEST_CASE("font: every printable character has a glyph that draws ink", "[image]
   for (char c = ' '; c <= '~'; ++c) {
     INFO("character '" << c << "'");
     REQUIRE(jsa::font_has_glyph(c));
-    jsa::Image cell(jsa::text_width(std::string(1, c)), jsa::text_height());
+    jsa::Image cell(jsa::text_width(std::string(1, c)), jsa::text_height() + 2);  // + descender
     jsa::draw_text(cell, 0, 0, std::string(1, c), jsa::colours::black());
     if (c == ' ')
       CHECK(count_pixels_not(cell, jsa::colours::white()) == 0);
