@@ -204,15 +204,29 @@ std::vector<Camera> three_views(const Block<double>& vertices, double fov_degree
   const Eigen::Vector3d low = vertices.colwise().minCoeff().transpose();
   const Eigen::Vector3d high = vertices.colwise().maxCoeff().transpose();
   const Eigen::Vector3d centre = 0.5 * (low + high);
-  double radius = 0.5 * (high - low).norm();
-  if (!(radius > 0)) radius = 1;  // a single point: any distance will do
-  // The bounding sphere subtends asin(radius / distance); make that 90% of half the fov.
-  const double distance = radius / (0.9 * std::sin(fov_degrees * M_PI / 360));
+  const double half_width = 0.9 * std::tan(fov_degrees * M_PI / 360);  // fill 90% of the frame
   const Eigen::Vector3d directions[3] = {
       {0, 0, 1}, {1, 0, 0}, Eigen::Vector3d(1, 1, 1).normalized()};  // front, side, 3/4 top
+  const Eigen::Vector3d up(0, 1, 0);
   std::vector<Camera> cameras;
-  for (const Eigen::Vector3d& direction : directions)
-    cameras.push_back({centre + distance * direction, centre, {0, 1, 0}, fov_degrees});
+  for (const Eigen::Vector3d& towards_eye : directions) {
+    const Eigen::Vector3d right = up.cross(towards_eye).normalized();
+    const Eigen::Vector3d screen_up = towards_eye.cross(right);
+    // A box corner at sideways offset s and depth offset d (towards the eye) is in
+    // frame when s / (distance - d) <= half_width. Since projection keeps lines
+    // straight, the whole box is in frame when its eight corners are.
+    double distance = 0;
+    for (int k = 0; k < 8; ++k) {
+      const Eigen::Vector3d corner((k & 1 ? high : low).x(), (k & 2 ? high : low).y(),
+                                   (k & 4 ? high : low).z());
+      const Eigen::Vector3d offset = corner - centre;
+      const double sideways =
+          std::max(std::abs(offset.dot(right)), std::abs(offset.dot(screen_up)));
+      distance = std::max(distance, offset.dot(towards_eye) + sideways / half_width);
+    }
+    if (!(distance > 0)) distance = 1;  // a single point: any distance will do
+    cameras.push_back({centre + distance * towards_eye, centre, up, fov_degrees});
+  }
   return cameras;
 }
 

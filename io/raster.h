@@ -48,8 +48,9 @@ Image render_textured_mesh(const Block<double>& vertices, const Faces& faces,
 Image render_points(const Block<double>& points, const Block<double>& colours, const Camera& camera,
                     const RenderOptions& options = {});
 
-// Front (looking down -z), side (down -x) and three-quarter top views, each far
-// enough back that the bounding sphere of the vertices fills about 90% of the frame.
+// Front (looking down -z), side (down -x) and three-quarter top views of the
+// bounding box, each as close as it can be with the whole box inside the central
+// 90% of a square frame. Up is +y in all three.
 std::vector<Camera> three_views(const Block<double>& vertices, double fov_degrees = 40);
 
 struct GridOptions {

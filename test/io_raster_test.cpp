@@ -120,8 +120,8 @@ TEST_CASE("three_views frames a cube: visible, inside the border, all different"
     CHECK(on_border == 0);
   }
   CHECK(views[0].rgb != views[2].rgb);
-  CHECK(count_pixels_not(views[2], jsa::colours::white()) >
-        count_pixels_not(views[0], jsa::colours::white()));  // 3/4 view shows three faces
+  // Tight framing: seen head-on, the near face fills about 90% of the width.
+  CHECK(count_pixels_not(views[0], jsa::colours::white()) > 0.7 * 96 * 96);
 }
 
 TEST_CASE("render_points: discs of the right size, nearer points in front", "[raster]") {
@@ -199,4 +199,24 @@ TEST_CASE("draw_uv_layout fills faces with their colour and outlines highlighted
     }
   CHECK(red_pixels > 100);  // three outlined edges of face 1
   CHECK_THROWS_AS(jsa::draw_uv_layout(uv, faces, {colours[0]}, {}, 100), jsa::InternalError);
+}
+
+TEST_CASE("render_mesh interpolates colours perspective-correctly", "[raster]") {
+  // A quad receding in depth, black at the near edge and white at the far edge.
+  // The 3D midpoint projects above the screen midpoint; its colour must be mid-grey
+  // (screen-space interpolation would give a lighter grey there).
+  jsa::Block<double> vertices(4, 3), colours(4, 3);
+  vertices << -1, -1, 1, 1, -1, 1, 1, 1, -3, -1, 1, -3;
+  colours << 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1;
+  jsa::Faces faces(2, 3);
+  faces << 0, 1, 2, 0, 2, 3;
+  const jsa::Camera camera{{0, 0, 4}, {0, 0, 0}, {0, 1, 0}, 60};
+  const jsa::Image image = jsa::render_mesh(vertices, faces, colours, camera, flat_options(201));
+  // The midpoint (0, 0, -1) is on the optical axis: the centre pixel.
+  CHECK(image.get(100, 100).x() == Approx(0.5).margin(0.03));
+  // Screen-space weights would put mid-grey at the screen midpoint of the quad's
+  // near (y = 1 / 3 * focal) and far (y = -1 / 7 * focal) edges instead.
+  const double focal = 100.5 / std::tan(30 * M_PI / 180);
+  const int screen_midpoint = static_cast<int>(100.5 + 0.5 * (focal / 3 - focal / 7));
+  CHECK(image.get(100, screen_midpoint).x() < 0.4);
 }
