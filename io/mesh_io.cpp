@@ -34,10 +34,12 @@ Mesh read_shape(const std::string& path) {
 }
 
 void write_obj(const std::string& path, const Mesh& mesh, const Block<double>* uv,
-               const std::string& mtl_file, const std::string& material) {
+               const std::string& mtl_file, const std::string& material, const Faces* uv_faces) {
   const Index count = mesh.vertices.rows();
-  JSA_CHECK(uv == nullptr || (uv->rows() == count && uv->cols() == 2),
+  JSA_CHECK(uv == nullptr || ((uv_faces || uv->rows() == count) && uv->cols() == 2),
             "uv must be V x 2, got " << uv->rows() << " x " << uv->cols());
+  JSA_CHECK(uv_faces == nullptr || (uv && uv_faces->rows() == mesh.faces.rows()),
+            "uv_faces must be F x 3 and come with uv");
   JSA_CHECK(!mesh.has_normals() || mesh.normals.rows() == count, "normals must be V x 3");
   write_file_atomically(path, [&](std::ostream& out) {
     out << std::setprecision(std::numeric_limits<double>::max_digits10);
@@ -47,7 +49,7 @@ void write_obj(const std::string& path, const Mesh& mesh, const Block<double>* u
       out << "v " << mesh.vertices(v, 0) << " " << mesh.vertices(v, 1) << " " << mesh.vertices(v, 2)
           << "\n";
     if (uv)
-      for (Index v = 0; v < count; ++v) out << "vt " << (*uv)(v, 0) << " " << (*uv)(v, 1) << "\n";
+      for (Index v = 0; v < uv->rows(); ++v) out << "vt " << (*uv)(v, 0) << " " << (*uv)(v, 1) << "\n";
     if (mesh.has_normals())
       for (Index v = 0; v < count; ++v)
         out << "vn " << mesh.normals(v, 0) << " " << mesh.normals(v, 1) << " " << mesh.normals(v, 2)
@@ -57,16 +59,24 @@ void write_obj(const std::string& path, const Mesh& mesh, const Block<double>* u
       out << "f";
       for (int k = 0; k < 3; ++k) {
         const int i = mesh.faces(f, k) + 1;  // OBJ indices are 1-based
+        const int t = uv_faces ? (*uv_faces)(f, k) + 1 : i;
         out << " " << i;
         if (uv && mesh.has_normals())
-          out << "/" << i << "/" << i;
+          out << "/" << t << "/" << i;
         else if (uv)
-          out << "/" << i;
+          out << "/" << t;
         else if (mesh.has_normals())
           out << "//" << i;
       }
       out << "\n";
     }
+  });
+}
+
+void write_mtl(const std::string& path, const std::string& material, const std::string& texture) {
+  write_file_atomically(path, [&](std::ostream& out) {
+    out << "# jsatlas\nnewmtl " << material << "\nKa 1 1 1\nKd 1 1 1\nKs 0 0 0\nillum 1\nmap_Kd "
+        << texture << "\n";
   });
 }
 

@@ -7,6 +7,17 @@
 
 namespace jsa {
 
+// Domain coordinates -> texture coordinates in [0,1]^2: the square around the
+// means +- 3 sigma. Every UV the tool writes (meshed domain, charts of input
+// meshes, every shape of a collection) uses this one frame, so one texture
+// image lines up on all of them.
+struct TextureFrame {
+  Eigen::RowVector2d lo = Eigen::RowVector2d::Zero();
+  double side = 1;
+  Block<double> to_texture(const Block<double>& uv) const;
+};
+TextureFrame texture_frame(const Atlas<float>& atlas);
+
 struct DomainMeshOptions {
   int resolution = 256;    // grid cells along the longer side of the domain's bounding box
   double threshold = 0.3;  // keep P(x) >= threshold * (median of P at the means)
@@ -16,7 +27,7 @@ struct DomainMesh {
   Block<double> uv;                                          // V x 2 domain coordinates
   Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor> faces;  // F x 3, counter-clockwise in uv
   double level = 0;          // the absolute density threshold used
-  double mass_fraction = 0;  // share of P's mass inside the kept cells (grid estimate)
+  double mass_fraction = 0;  // share of P's mass where P >= level (grid estimate)
   Eigen::RowVector2d lo, hi;  // the grid's bounding box (vt = (uv - lo) / (hi - lo))
 };
 
