@@ -111,6 +111,7 @@ void check_shapes(const Block<T>& queries, const Block<T>& points) {
   JSA_CHECK(queries.cols() == points.cols(),
             "nearest: queries have " << queries.cols() << " columns, points " << points.cols());
   JSA_CHECK(points.rows() < Index(std::numeric_limits<int>::max()), "nearest: too many points");
+  JSA_CHECK(queries.allFinite() && points.allFinite(), "nearest: a coordinate is not finite");
 }
 
 }  // namespace
