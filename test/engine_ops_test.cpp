@@ -12,6 +12,7 @@
 #include <iomanip>
 #include <iostream>
 #include <sstream>
+#include <tuple>
 
 #include "engine/ops.h"
 #include "engine/tangents.h"
@@ -323,6 +324,32 @@ TEST_CASE("float ops agree with double ops", "[ops][float]") {
   const auto [ld, gd] = run(0.0);
   CHECK(lf == Approx(ld).epsilon(1e-5));
   CHECK((gf - gd).cwiseAbs().maxCoeff() < 1e-5 * std::max(1.0, gd.cwiseAbs().maxCoeff()));
+}
+
+}  // namespace jsa::test
+
+namespace jsa::test {
+
+// Same inputs and thread count -> the same bits (STYLE: no float atomics, no
+// order-dependent reductions), on blocks tall enough to run threaded.
+TEST_CASE("the same graph twice gives bitwise-identical gradients", "[ops][determinism]") {
+  Rng rng(31);
+  const Index n = 4000;
+  const Block<float> x0 = signed_block(rng, n, 2).cast<float>(), w1 = signed_block(rng, 2, 64).cast<float>(),
+                     b1 = signed_block(rng, 1, 64).cast<float>(), w2 = signed_block(rng, 64, 3).cast<float>();
+  auto run = [&] {
+    Tape<float> t;
+    Var w = t.variable(w1), b = t.variable(b1), v = t.variable(w2);
+    Var h = relu_masked(t, linear(t, stack_tangents(t, t.constant(x0)), w, b, n), n);
+    const Stacked s = unstack(t, linear(t, h, v, Var{}, n));
+    Var loss = add(t, mean(t, row_norm(t, cross3(t, s.du, s.dv))), mean(t, square(t, s.value)));
+    t.backward(loss);
+    return std::make_tuple(Block<float>(t.grad(w)), Block<float>(t.grad(b)), Block<float>(t.grad(v)));
+  };
+  const auto first = run(), second = run();
+  CHECK(std::get<0>(first) == std::get<0>(second));
+  CHECK(std::get<1>(first) == std::get<1>(second));
+  CHECK(std::get<2>(first) == std::get<2>(second));
 }
 
 }  // namespace jsa::test
