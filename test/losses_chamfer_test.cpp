@@ -8,6 +8,7 @@
 
 #include "engine/gradcheck.h"
 #include "engine/ops.h"
+#include "engine/parallel.h"
 #include "engine/rng.h"
 #include "losses/chamfer.h"
 
@@ -166,6 +167,24 @@ TEST_CASE("chamfer with a constant side only differentiates the other", "[chamfe
   loss = chamfer(t, vx, vy);
   t.backward(loss);
   CHECK(t.grad(vx) == first);
+}
+
+TEST_CASE("chamfer gradients do not depend on the thread count", "[chamfer]") {
+  // Enough rows that the own-row pull-back runs in several parallel chunks.
+  const Block<float> x = random_block(9000, 3, 700).cast<float>();
+  const Block<float> y = random_block(7000, 3, 701).cast<float>();
+  auto gradients = [&](int threads) {
+    set_threads(threads);
+    Tape<float> t;
+    Var vx = t.variable(x), vy = t.variable(y);
+    t.backward(chamfer(t, vx, vy));
+    return std::make_pair(Block<float>(t.grad(vx)), Block<float>(t.grad(vy)));
+  };
+  const int threads = max_threads();
+  const auto one = gradients(1), two = gradients(std::max(2, threads));
+  set_threads(threads);
+  CHECK(one.first == two.first);
+  CHECK(one.second == two.second);
 }
 
 TEST_CASE("chamfer timing at training-loop sizes", "[.bench][chamfer]") {
