@@ -70,8 +70,14 @@ struct Axis {
     }
     const double from = log ? std::pow(10, low) : low, to = log ? std::pow(10, high) : high;
     const double step = nice_step((to - from) / 5);
-    for (double v = std::ceil(from / step) * step; v <= to + 1e-9 * step; v += step)
+    // Counted, not accumulated: a step below the rounding of `from` cannot loop forever.
+    const double first = std::ceil(from / step) * step;
+    const int count =
+        std::clamp(static_cast<int>(std::floor((to - first) / step + 1e-9)) + 1, 0, 20);
+    for (int i = 0; i < count; ++i) {
+      const double v = first + i * step;
       values.push_back(std::abs(v) < 1e-9 * step ? 0 : v);
+    }
     return values;
   }
 };
@@ -215,8 +221,9 @@ HeatMap heat_map(const Block<double>& values, const HeatMapOptions& options) {
   map.cell = static_cast<double>(options.size) / std::max(values.rows(), values.cols());
   map.left = pad;
   map.top = pad + (options.title.empty() ? 0 : text_height(2) + pad);
-  const int grid_width = static_cast<int>(std::lround(values.cols() * map.cell));
-  const int grid_height = static_cast<int>(std::lround(values.rows() * map.cell));
+  map.rows = values.rows(), map.cols = values.cols();
+  const int grid_width = std::max(1, static_cast<int>(std::lround(values.cols() * map.cell)));
+  const int grid_height = std::max(1, static_cast<int>(std::lround(values.rows() * map.cell)));
   const std::string labels[3] = {format_number(high), format_number(0.5 * (low + high)),
                                  format_number(low)};
   const int bar_x = pad + grid_width + 12, bar_width = 14;
@@ -267,6 +274,9 @@ void draw_contour(HeatMap& map, const Block<double>& values, double level, const
   // Each square joins four cell centres, corners in order a=(r,c), b=(r,c+1),
   // c=(r+1,c+1), d=(r+1,c); edge k runs from corner k to corner k+1 (top, right,
   // bottom, left). The iso-line crosses an edge where its ends lie on either side.
+  JSA_CHECK(values.rows() == map.rows && values.cols() == map.cols,
+            "contour of a " << values.rows() << " x " << values.cols() << " grid drawn on a "
+                            << map.rows << " x " << map.cols << " heat map");
   const int corner_row[4] = {0, 0, 1, 1}, corner_column[4] = {0, 1, 1, 0};
   for (Index r = 0; r + 1 < values.rows(); ++r)
     for (Index c = 0; c + 1 < values.cols(); ++c) {

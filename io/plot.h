@@ -52,6 +52,7 @@ struct HeatMap {
   Image image;
   double left = 0, top = 0;  // pixel position of the grid's top-left corner
   double cell = 1;           // pixels per cell (may be below 1 for big grids)
+  Index rows = 0, cols = 0;  // the grid's size
   Eigen::Vector2d to_pixel(double column, double row) const {
     return {left + (column + 0.5) * cell, top + (row + 0.5) * cell};
   }
@@ -67,6 +68,7 @@ void draw_grid_polyline(HeatMap& map, const std::vector<Eigen::Vector2d>& points
                         const Colour& colour, double width = 1.5, bool closed = false);
 // The iso-line values == level by marching squares over the cell centres
 // (linear interpolation along cell edges; saddles split by the centre average).
+// values must be the grid the map was made from (same rows and cols).
 void draw_contour(HeatMap& map, const Block<double>& values, double level, const Colour& colour,
                   double width = 1.5);
 

@@ -37,8 +37,12 @@ TEST_CASE("line_plot: a rising series rises, in its own colour", "[plot]") {
   jsa::PlotOptions options;
   options.legend = false;
   const jsa::Image image = jsa::line_plot({rising}, options);
-  CHECK(image.width == 640);
-  CHECK(image.height == 420);
+  // Lines stay inside the frame: no series colour in the outer 8 pixel margin.
+  int outside = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x : {0, 7, image.width - 8, image.width - 1})
+      outside += near(image.get(x, y), jsa::series_colour(0));
+  CHECK(outside == 0);
   int count = 0;
   const auto [left, right] = mean_rows_left_right(image, jsa::series_colour(0), count);
   CHECK(count > 300);
@@ -90,6 +94,8 @@ TEST_CASE("line_plot: log scale rejects values <= 0, naming the series", "[plot]
   CHECK(jsa::line_plot({gaps}, options).width == 640);
   CHECK(jsa::line_plot({}, options).width == 640);
   CHECK(jsa::line_plot({{"one", {3}, {3}}}, options).width == 640);
+  // A range far below the rounding of its values still terminates with a few ticks.
+  CHECK(jsa::line_plot({{"flat", {0, 1}, {1e6, 1e6 + 1e-10}}}, options).width == 640);
 }
 
 TEST_CASE("heat_map colours cells by value and overlays land on grid coordinates", "[plot]") {
@@ -139,4 +145,11 @@ TEST_CASE("heat_map: constant and non-finite grids", "[plot]") {
   CHECK(near(map.image.get(int(missing.x()), int(missing.y())), jsa::colours::grey(0.6)));
   CHECK(near(map.image.get(int(other.x()), int(other.y())), jsa::viridis(0.5)));
   CHECK_THROWS_AS(jsa::heat_map(jsa::Block<double>(0, 3)), jsa::InternalError);
+  jsa::HeatMap copy = map;
+  CHECK_THROWS_AS(jsa::draw_contour(copy, jsa::Block<double>::Zero(3, 4), 0.5, {1, 1, 1}),
+                  jsa::InternalError);
+  // A grid much larger than the picture still draws (cells below a pixel).
+  const jsa::HeatMap tall = jsa::heat_map(jsa::Block<double>::Random(1000, 3));
+  CHECK(tall.image.height > 400);
+  CHECK(tall.cell == Approx(0.4));
 }
