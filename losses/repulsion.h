@@ -9,7 +9,7 @@
 // contributes exp(0) = 1 to L and zero to the gradient (the symmetric choice).
 //
 // The exact sum is O(K^2). The fast version drops pairs farther apart than the
-// cut-off r_c = sigma ln(1/tolerance), found with a uniform grid of cells >= r_c:
+// cut-off r_c = sigma ln(1/tolerance), found with a uniform grid (cells r_c / 4):
 //  - value: each dropped pair has exp(-d/sigma) < tolerance, and there are fewer
 //    than K^2 of them, so |L - L_exact| < tolerance;
 //  - gradient: each dropped term of dL/dmu_i has norm 2/(K^2 sigma) exp(-d/sigma)
