@@ -1,6 +1,6 @@
 // Line plots and heat maps. An Axis maps data values to [0, 1] (linearly or by
-// log10) and chooses ticks: 1-2-5 steps for linear axes, powers of ten for log
-// axes spanning at least a decade. Contours use marching squares.
+// log10) and chooses ticks: 1-2-5 steps for linear axes; on log axes, powers of
+// ten past three decades, else 1, 2 and 5 times them. Contours use marching squares.
 #include "io/plot.h"
 
 #include <algorithm>
@@ -70,6 +70,7 @@ struct Axis {
     }
     const double from = log ? std::pow(10, low) : low, to = log ? std::pow(10, high) : high;
     const double step = nice_step((to - from) / 5);
+    if (!(step > 0) || !std::isfinite(step)) return values;  // a range past double's reach
     // Counted, not accumulated: a step below the rounding of `from` cannot loop forever.
     const double first = std::ceil(from / step) * step;
     const int count =
@@ -107,6 +108,72 @@ Colour series_colour(int index) {
   return kPalette[((index % 10) + 10) % 10];
 }
 
+namespace {
+
+// The data rectangle inside the picture, and the axes that map into it.
+struct Frame {
+  int left, top, right, bottom;
+  Axis x_axis, y_axis;
+  double x_pixel(double x) const { return left + x_axis.to_unit(x) * (right - left); }
+  double y_pixel(double y) const { return bottom - y_axis.to_unit(y) * (bottom - top); }
+};
+
+constexpr int kPad = 8;
+const int kLine = text_height() + kPad;  // one line of size-1 text and its spacing
+
+// Grid lines, tick marks and labels, the frame, title and axis labels.
+void draw_axes(Image& image, const Frame& frame, const PlotOptions& options) {
+  for (double t : frame.x_axis.ticks()) {
+    const int px = static_cast<int>(std::lround(frame.x_pixel(t)));
+    fill_rectangle(image, px, frame.top, px + 1, frame.bottom, colours::grey(0.9));
+    fill_rectangle(image, px, frame.bottom, px + 1, frame.bottom + 4, colours::black());
+    const std::string label = format_number(t);
+    draw_text(image, px - text_width(label) / 2, frame.bottom + 6, label, colours::black());
+  }
+  for (double t : frame.y_axis.ticks()) {
+    const int py = static_cast<int>(std::lround(frame.y_pixel(t)));
+    fill_rectangle(image, frame.left, py, frame.right, py + 1, colours::grey(0.9));
+    fill_rectangle(image, frame.left - 4, py, frame.left, py + 1, colours::black());
+    const std::string label = format_number(t);
+    draw_text(image, frame.left - 6 - text_width(label), py - text_height() / 2, label,
+              colours::black());
+  }
+  draw_rectangle_outline(image, frame.left, frame.top, frame.right + 1, frame.bottom + 1,
+                         colours::black());
+  if (!options.title.empty())
+    draw_text(image, (options.width - text_width(options.title, 2)) / 2, kPad, options.title,
+              colours::black(), 2);
+  if (!options.y_label.empty())
+    draw_text(image, kPad, frame.top - 4 - kLine, options.y_label, colours::black());
+  if (!options.x_label.empty())
+    draw_text(image, (frame.left + frame.right - text_width(options.x_label)) / 2,
+              frame.bottom + 6 + kLine, options.x_label, colours::black());
+}
+
+// A boxed list of line samples and names in the upper-right corner of the frame.
+void draw_legend(Image& image, const Frame& frame, const std::vector<Series>& series,
+                 double line_width) {
+  int named = 0, longest = 0;
+  for (const Series& s : series)
+    if (!s.name.empty()) ++named, longest = std::max(longest, text_width(s.name));
+  if (named == 0) return;
+  const int box_width = longest + 36, box_height = named * kLine + kPad;
+  const int x0 = frame.right - kPad - box_width, y0 = frame.top + kPad;
+  fill_rectangle(image, x0, y0, x0 + box_width, y0 + box_height, colours::white());
+  draw_rectangle_outline(image, x0, y0, x0 + box_width, y0 + box_height, colours::grey(0.6));
+  int y = y0 + kPad;
+  for (std::size_t k = 0; k < series.size(); ++k) {
+    if (series[k].name.empty()) continue;
+    const double middle = y + text_height() / 2.0;
+    draw_line(image, {x0 + 6.0, middle}, {x0 + 24.0, middle}, series_colour(static_cast<int>(k)),
+              line_width);
+    draw_text(image, x0 + 30, y, series[k].name, colours::black());
+    y += kLine;
+  }
+}
+
+}  // namespace
+
 Image line_plot(const std::vector<Series>& series, const PlotOptions& options) {
   JSA_CHECK(options.width > 0 && options.height > 0, "plot size");
   double x_min = 0, x_max = 1, y_min = 0, y_max = 1;
@@ -122,80 +189,39 @@ Image line_plot(const std::vector<Series>& series, const PlotOptions& options) {
   if (!any_y && options.log_y) y_min = 1, y_max = 10;
   const Axis x_axis(x_min, x_max, options.log_x), y_axis(y_min, y_max, options.log_y);
 
-  // Layout: title and y label above the frame, tick labels left and below, x label under them.
-  const std::vector<double> x_ticks = x_axis.ticks(), y_ticks = y_axis.ticks();
+  // Layout: title and y label above the frame, tick labels left of and below it,
+  // the x label under those.
   int widest_y_label = 0;
-  for (double t : y_ticks) widest_y_label = std::max(widest_y_label, text_width(format_number(t)));
-  const int pad = 8, line = text_height() + pad;
-  const int top = pad + (options.title.empty() ? 0 : text_height(2) + pad) +
-                  (options.y_label.empty() ? 0 : line) + 4;
-  const int left = pad + widest_y_label + 6;
-  const int right = options.width - 3 * pad;
-  const int bottom = options.height - pad - line - (options.x_label.empty() ? 0 : line);
+  for (double t : y_axis.ticks())
+    widest_y_label = std::max(widest_y_label, text_width(format_number(t)));
+  const Frame frame{kPad + widest_y_label + 6,
+                    kPad + (options.title.empty() ? 0 : text_height(2) + kPad) +
+                        (options.y_label.empty() ? 0 : kLine) + 4,
+                    options.width - 3 * kPad,
+                    options.height - kPad - kLine - (options.x_label.empty() ? 0 : kLine),
+                    x_axis,
+                    y_axis};
   Image image(options.width, options.height, colours::white());
-  auto x_pixel = [&](double x) { return left + x_axis.to_unit(x) * (right - left); };
-  auto y_pixel = [&](double y) { return bottom - y_axis.to_unit(y) * (bottom - top); };
-
-  for (double t : x_ticks) {  // grid line, tick mark, label
-    const int px = static_cast<int>(std::lround(x_pixel(t)));
-    fill_rectangle(image, px, top, px + 1, bottom, colours::grey(0.9));
-    fill_rectangle(image, px, bottom, px + 1, bottom + 4, colours::black());
-    const std::string label = format_number(t);
-    draw_text(image, px - text_width(label) / 2, bottom + 6, label, colours::black());
-  }
-  for (double t : y_ticks) {
-    const int py = static_cast<int>(std::lround(y_pixel(t)));
-    fill_rectangle(image, left, py, right, py + 1, colours::grey(0.9));
-    fill_rectangle(image, left - 4, py, left, py + 1, colours::black());
-    const std::string label = format_number(t);
-    draw_text(image, left - 6 - text_width(label), py - text_height() / 2, label, colours::black());
-  }
-  draw_rectangle_outline(image, left, top, right + 1, bottom + 1, colours::black());
-  if (!options.title.empty())
-    draw_text(image, (options.width - text_width(options.title, 2)) / 2, pad, options.title,
-              colours::black(), 2);
-  if (!options.y_label.empty())
-    draw_text(image, pad, top - 4 - line, options.y_label, colours::black());
-  if (!options.x_label.empty())
-    draw_text(image, (left + right - text_width(options.x_label)) / 2, bottom + 6 + line,
-              options.x_label, colours::black());
+  draw_axes(image, frame, options);
 
   for (std::size_t k = 0; k < series.size(); ++k) {
     const Series& s = series[k];
     const Colour colour = series_colour(static_cast<int>(k));
-    bool have_previous = false;
+    bool have_previous = false;  // false at the start and after a skipped point
     Eigen::Vector2d previous;
     for (std::size_t i = 0; i < s.x.size(); ++i) {
       if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) {
         have_previous = false;
         continue;
       }
-      const Eigen::Vector2d p(x_pixel(s.x[i]), y_pixel(s.y[i]));
+      const Eigen::Vector2d p(frame.x_pixel(s.x[i]), frame.y_pixel(s.y[i]));
       if (have_previous) draw_line(image, previous, p, colour, options.line_width);
       if (options.markers || s.x.size() == 1)
         fill_circle(image, p, options.line_width + 1.5, colour);
       previous = p, have_previous = true;
     }
   }
-
-  int named = 0, longest = 0;
-  for (const Series& s : series)
-    if (!s.name.empty()) ++named, longest = std::max(longest, text_width(s.name));
-  if (options.legend && named > 0) {
-    const int box_width = longest + 36, box_height = named * line + pad;
-    const int x0 = right - pad - box_width, y0 = top + pad;
-    fill_rectangle(image, x0, y0, x0 + box_width, y0 + box_height, colours::white());
-    draw_rectangle_outline(image, x0, y0, x0 + box_width, y0 + box_height, colours::grey(0.6));
-    int y = y0 + pad;
-    for (std::size_t k = 0; k < series.size(); ++k) {
-      if (series[k].name.empty()) continue;
-      const double middle = y + text_height() / 2.0;
-      draw_line(image, {x0 + 6.0, middle}, {x0 + 24.0, middle}, series_colour(static_cast<int>(k)),
-                options.line_width);
-      draw_text(image, x0 + 30, y, series[k].name, colours::black());
-      y += line;
-    }
-  }
+  if (options.legend) draw_legend(image, frame, series, options.line_width);
   return image;
 }
 
