@@ -13,5 +13,7 @@ struct ExitCode {
 
 void add_fit(CLI::App& app);
 void add_eval(CLI::App& app);
+void add_mesh(CLI::App& app);
+void add_chart(CLI::App& app);
 
 }  // namespace jsa::cli

@@ -140,7 +140,7 @@ void run_fit(FitArgs& a) {
     }
   }
   save();
-  write_run_outputs(trainer.atlas(), shape, dir, a.mesh_resolution, a.mesh_threshold, a.quiet);
+  write_run_outputs(trainer.atlas(), shape, log, dir, MeshOutputOptions{a.mesh_resolution, a.mesh_threshold, a.quiet});
   if (!a.quiet)
     std::cerr << "fit: done in " << format_duration(std::chrono::duration<double>(clock::now() - start).count())
               << "; results in " << dir << "\n";

@@ -10,6 +10,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "jsatlas 0.1.0");
   jsa::cli::add_fit(app);
+  jsa::cli::add_mesh(app);
+  jsa::cli::add_chart(app);
   jsa::cli::add_eval(app);
   try {
     app.parse(argc, argv);

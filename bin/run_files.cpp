@@ -1,34 +1,119 @@
 #include "bin/run_files.h"
 
+#include <filesystem>
 #include <iostream>
 
 #include <nlohmann/json.hpp>
 
+#include "io/atomic_write.h"
 #include "io/mesh_io.h"
+#include "losses/uv_quality.h"
+#include "model/chart_mesh.h"
 #include "model/domain_mesh.h"
+#include "model/pictures.h"
 
 namespace jsa::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string stem_of(const std::string& obj_path) {
+  const fs::path p(obj_path);
+  return (p.parent_path() / p.stem()).string();
+}
+
+// OUT.mtl and the shared texture next to OUT.obj; returns the MTL's file name.
+std::string write_material(const std::string& obj_path) {
+  const fs::path p(obj_path);
+  const std::string texture = "jsatlas_texture.png";
+  const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+  write_png((dir / texture).string(), colour_chart(1024));
+  const std::string mtl = p.stem().string() + ".mtl";
+  write_mtl((dir / mtl).string(), "atlas", texture);
+  return mtl;
+}
+
+void write_report(const std::string& path, const UvQuality& q, const nlohmann::json& extra) {
+  nlohmann::json j = to_json(q);
+  for (auto it = extra.begin(); it != extra.end(); ++it) j[it.key()] = it.value();
+  write_file_atomically(path, [&](std::ostream& out) { out << j.dump(2) << "\n"; });
+}
+
+}  // namespace
 
 std::string json_quote(const std::string& s) { return nlohmann::json(s).dump(); }
 
-void write_run_outputs(Atlas<float>& atlas, const RunInput& input, const std::string& dir,
-                       int mesh_resolution, double mesh_threshold, bool quiet) {
-  DomainMesh dm = mesh_domain(atlas, DomainMeshOptions{mesh_resolution, mesh_threshold});
+void write_domain_mesh(Atlas<float>& atlas, const Normalization& normalization,
+                       const std::string& obj_path, const MeshOutputOptions& o) {
+  const DomainMesh dm = mesh_domain(atlas, DomainMeshOptions{o.resolution, o.threshold});
+  if (dm.faces.rows() == 0)
+    throw InputError("mesh: no domain above the threshold " + std::to_string(o.threshold) + " (lower --threshold)");
   Mesh out;
   Block<double> points, normals;
   evaluate_surface(atlas, dm.uv, points, normals);
-  out.vertices = input.normalization.from_unit(points);
+  out.vertices = normalization.from_unit(points);
   out.normals = normals;
   out.faces = dm.faces;
-  Block<double> vt(dm.uv.rows(), 2);
-  const Eigen::RowVector2d extent = dm.hi - dm.lo;
-  const double side = std::max(extent(0), extent(1));
-  for (Index i = 0; i < dm.uv.rows(); ++i) vt.row(i) = (dm.uv.row(i) - dm.lo) / side;
-  write_obj(dir + "/domain_mesh.obj", out, &vt);
-  if (!quiet)
-    std::cerr << "mesh: " << dir << "/domain_mesh.obj  (" << out.vertices.rows() << " vertices, "
-              << out.faces.rows() << " triangles; the domain holds " << int(100 * dm.mass_fraction + 0.5)
-              << "% of P's mass)\n";
+  const Block<double> vt = texture_frame(atlas).to_texture(dm.uv);
+  write_obj(obj_path, out, &vt, write_material(obj_path), "atlas");
+  const std::string stem = stem_of(obj_path);
+  const UvQuality q = measure_uv_quality(out.vertices, out.faces, vt, out.faces);
+  write_report(stem + "_uv.json", q, {{"domain_mass_fraction", dm.mass_fraction}, {"threshold", o.threshold},
+                                      {"level", dm.level}, {"map", "domain uv -> phi (3D)"}});
+  write_png(stem + ".png", domain_coloured_views(out.vertices, out.faces, vt));
+  if (!o.quiet) {
+    std::cerr << "mesh: " << obj_path << "  (" << out.vertices.rows() << " vertices, " << out.faces.rows()
+              << " triangles; the domain holds " << int(100 * dm.mass_fraction + 0.5) << "% of P's mass)\n";
+    std::cerr << to_text(q);
+  }
+}
+
+void write_chart(Atlas<float>& atlas, const Normalization& normalization, const Mesh& mesh,
+                 const std::string& obj_path, const ChartOutputOptions& o) {
+  if (mesh.faces.rows() == 0) throw InputError("chart: the input has no faces (a point cloud has no UV map to write)");
+  const Block<double> uv = chart_vertices(atlas, mesh, normalization);
+  const TextureFrame frame = texture_frame(atlas);
+  Block<double> vt = frame.to_texture(uv);
+  UvQualityOptions qo;
+  qo.torn_ratio = o.torn_ratio;
+  UvQuality q = measure_uv_quality(mesh.vertices, mesh.faces, vt, mesh.faces, qo);
+  Faces uv_faces = mesh.faces;
+  const Index torn_before = q.torn;
+  if (o.split_cuts && q.torn > 0) {
+    SplitUv split = split_torn(atlas, mesh, normalization, uv, q.torn_faces);
+    vt = frame.to_texture(split.uv);
+    uv_faces = split.uv_faces;
+    q = measure_uv_quality(mesh.vertices, mesh.faces, vt, uv_faces, qo);
+  }
+  write_obj(obj_path, mesh, &vt, write_material(obj_path), "atlas", o.split_cuts ? &uv_faces : nullptr);
+  const std::string stem = stem_of(obj_path);
+  write_report(stem + "_uv.json", q, {{"map", "input mesh -> psi (2D); measured as uv -> 3D"},
+                                      {"split_cuts", o.split_cuts}, {"torn_before_split", torn_before}});
+  const Block<double> vertex_vt = frame.to_texture(uv);
+  write_png(stem + ".png", domain_coloured_views(mesh.vertices, mesh.faces, vertex_vt));
+  std::vector<bool> highlight(size_t(mesh.faces.rows()), false);
+  for (int f : q.torn_faces) highlight[size_t(f)] = true;
+  for (int f : q.flipped_faces) highlight[size_t(f)] = true;
+  write_png(stem + "_layout.png", uv_layout_picture(mesh.vertices, mesh.faces, vt, uv_faces, highlight));
+  if (!o.quiet) {
+    std::cerr << "chart: " << obj_path << "  (" << mesh.vertices.rows() << " vertices, " << mesh.faces.rows()
+              << " faces in the input's order; " << torn_before << " torn across the cut"
+              << (o.split_cuts ? ", split" : "") << ")\n";
+    std::cerr << to_text(q);
+  }
+}
+
+void write_run_outputs(Atlas<float>& atlas, const RunInput& input, const LossLog& log,
+                       const std::string& dir, const MeshOutputOptions& mesh) {
+  write_domain_mesh(atlas, input.normalization, dir + "/domain_mesh.obj", mesh);
+  if (input.mesh.faces.rows() > 0) {
+    ChartOutputOptions co;
+    co.quiet = mesh.quiet;
+    write_chart(atlas, input.normalization, input.mesh, dir + "/input_chart.obj", co);
+  }
+  const DomainMesh dm = mesh_domain(atlas, DomainMeshOptions{64, mesh.threshold});
+  write_png(dir + "/domain.png", domain_picture(atlas, dm.level));
+  if (!log.rows.empty()) write_png(dir + "/losses.png", loss_curves(log));
 }
 
 }  // namespace jsa::cli

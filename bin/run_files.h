@@ -1,5 +1,6 @@
-// Glue shared by the subcommands: loading a run's input, its loss log, and
-// writing the files a finished fit leaves behind.
+// Glue shared by the subcommands: what a finished fit leaves behind (meshes
+// with UVs, UV quality reports, pictures), each also reachable on its own
+// through `jsatlas mesh` and `jsatlas chart`.
 #pragma once
 #include <string>
 
@@ -10,9 +11,30 @@
 namespace jsa::cli {
 
 std::string json_quote(const std::string& s);
-// DIR/domain_mesh.obj (the thresholded domain mapped through phi, in the
-// input's frame, with vt and vn).
-void write_run_outputs(Atlas<float>& atlas, const RunInput& input, const std::string& dir,
-                       int mesh_resolution, double mesh_threshold, bool quiet);
+
+struct MeshOutputOptions {
+  int resolution = 256;    // grid cells across the domain
+  double threshold = 0.3;  // domain = {P >= threshold * median of P at the means}
+  bool quiet = false;
+};
+// OUT.obj (+ .mtl, texture PNG, _uv.json report, .png three views): the
+// thresholded domain mapped through phi, in the input's frame.
+void write_domain_mesh(Atlas<float>& atlas, const Normalization& normalization,
+                       const std::string& obj_path, const MeshOutputOptions& o);
+
+struct ChartOutputOptions {
+  bool split_cuts = false;  // give torn triangles their own UV corners (no smeared triangles)
+  double torn_ratio = 10;   // a UV edge this many times longer than its 3D edge is torn
+  bool quiet = false;
+};
+// OUT.obj with the user's vertices and faces in their order and vt from psi,
+// OUT_uv.json, OUT.png (three views coloured through the chart), OUT_layout.png.
+void write_chart(Atlas<float>& atlas, const Normalization& normalization, const Mesh& mesh,
+                 const std::string& obj_path, const ChartOutputOptions& o);
+
+// Everything at the end of `fit`: domain_mesh.*, input_chart.* (for mesh
+// inputs), domain.png, losses.png.
+void write_run_outputs(Atlas<float>& atlas, const RunInput& input, const LossLog& log,
+                       const std::string& dir, const MeshOutputOptions& mesh);
 
 }  // namespace jsa::cli
