@@ -88,6 +88,14 @@ void write_png(const std::string& path, const Image& image) {
 
 // ---- drawing ----
 
+PixelSpan pixel_span(double low, double high, int size) {
+  if (!(low <= high)) return {0, -1};  // also NaN
+  const double first = std::max(std::floor(low), 0.0);
+  const double last = std::min(std::ceil(high), size - 1.0);
+  if (first > last) return {0, -1};
+  return {static_cast<int>(first), static_cast<int>(last)};
+}
+
 void fill_rectangle(Image& image, int x0, int y0, int x1, int y1, const Colour& colour) {
   x0 = std::max(x0, 0), y0 = std::max(y0, 0);
   x1 = std::min(x1, image.width), y1 = std::min(y1, image.height);
@@ -105,12 +113,12 @@ void draw_rectangle_outline(Image& image, int x0, int y0, int x1, int y1, const 
 void draw_line(Image& image, const Eigen::Vector2d& from, const Eigen::Vector2d& to,
                const Colour& colour, double width) {
   const double reach = width / 2 + 1;
-  const int x0 = static_cast<int>(std::floor(std::min(from.x(), to.x()) - reach));
-  const int x1 = static_cast<int>(std::ceil(std::max(from.x(), to.x()) + reach));
-  const int y0 = static_cast<int>(std::floor(std::min(from.y(), to.y()) - reach));
-  const int y1 = static_cast<int>(std::ceil(std::max(from.y(), to.y()) + reach));
-  for (int y = std::max(y0, 0); y <= std::min(y1, image.height - 1); ++y)
-    for (int x = std::max(x0, 0); x <= std::min(x1, image.width - 1); ++x) {
+  const PixelSpan xs = pixel_span(std::min(from.x(), to.x()) - reach,
+                                  std::max(from.x(), to.x()) + reach, image.width);
+  const PixelSpan ys = pixel_span(std::min(from.y(), to.y()) - reach,
+                                  std::max(from.y(), to.y()) + reach, image.height);
+  for (int y = ys.first; y <= ys.last; ++y)
+    for (int x = xs.first; x <= xs.last; ++x) {
       const double distance = distance_to_segment(pixel_centre(x, y), from, to);
       image.blend(x, y, colour, width / 2 + 0.5 - distance);
     }
@@ -134,14 +142,12 @@ void fill_triangle(Image& image, const Eigen::Vector2d& a, const Eigen::Vector2d
   const double area = edge(a, b, c);
   if (area == 0 || !std::isfinite(area)) return;
   const double sign = area > 0 ? 1 : -1;
-  const int x0 = std::max(0, static_cast<int>(std::floor(std::min({a.x(), b.x(), c.x()}))));
-  const int x1 =
-      std::min(image.width - 1, static_cast<int>(std::ceil(std::max({a.x(), b.x(), c.x()}))));
-  const int y0 = std::max(0, static_cast<int>(std::floor(std::min({a.y(), b.y(), c.y()}))));
-  const int y1 =
-      std::min(image.height - 1, static_cast<int>(std::ceil(std::max({a.y(), b.y(), c.y()}))));
-  for (int y = y0; y <= y1; ++y)
-    for (int x = x0; x <= x1; ++x) {
+  const PixelSpan xs =
+      pixel_span(std::min({a.x(), b.x(), c.x()}), std::max({a.x(), b.x(), c.x()}), image.width);
+  const PixelSpan ys =
+      pixel_span(std::min({a.y(), b.y(), c.y()}), std::max({a.y(), b.y(), c.y()}), image.height);
+  for (int y = ys.first; y <= ys.last; ++y)
+    for (int x = xs.first; x <= xs.last; ++x) {
       const Eigen::Vector2d p = pixel_centre(x, y);
       if (sign * edge(a, b, p) >= 0 && sign * edge(b, c, p) >= 0 && sign * edge(c, a, p) >= 0)
         image.set(x, y, colour);
@@ -368,8 +374,8 @@ Image colour_chart(int size) {
 
 Colour sample_texture(const Image& texture, double u, double v) {
   JSA_CHECK(texture.width > 0 && texture.height > 0, "empty texture");
-  if (!std::isfinite(u)) u = 0;
-  if (!std::isfinite(v)) v = 0;
+  u = std::isfinite(u) ? std::clamp(u, 0.0, 1.0) : 0;  // clamp before converting to int
+  v = std::isfinite(v) ? std::clamp(v, 0.0, 1.0) : 0;
   const int x = std::clamp(static_cast<int>(std::floor(u * texture.width)), 0, texture.width - 1);
   const int y =
       std::clamp(static_cast<int>(std::floor((1 - v) * texture.height)), 0, texture.height - 1);

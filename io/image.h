@@ -46,6 +46,14 @@ void write_png(const std::string& path, const Image& image);
 
 // ---- drawing (all clipped to the image; coordinates in pixels, y down) ----
 
+// The pixel indices floor(low) .. ceil(high) along an axis of `size` pixels,
+// clipped to the image; first > last when nothing is left. Safe for huge,
+// infinite and NaN bounds (no out-of-range float -> int conversion).
+struct PixelSpan {
+  int first, last;
+};
+PixelSpan pixel_span(double low, double high, int size);
+
 // Pixels with x0 <= x < x1 and y0 <= y < y1.
 void fill_rectangle(Image& image, int x0, int y0, int x1, int y1, const Colour& colour);
 void draw_rectangle_outline(Image& image, int x0, int y0, int x1, int y1, const Colour& colour);

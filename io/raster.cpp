@@ -88,17 +88,12 @@ void rasterize_triangle(FrameBuffer& frame, const Eigen::Vector3d (&s)[3], Colou
   };
   const double area = edge(s[0], s[1], s[2].x(), s[2].y());
   if (area == 0 || !std::isfinite(area)) return;
-  const Image& image = frame.image;
-  const int x0 =
-      std::max(0, static_cast<int>(std::floor(std::min({s[0].x(), s[1].x(), s[2].x()}))));
-  const int x1 = std::min(image.width - 1,
-                          static_cast<int>(std::ceil(std::max({s[0].x(), s[1].x(), s[2].x()}))));
-  const int y0 =
-      std::max(0, static_cast<int>(std::floor(std::min({s[0].y(), s[1].y(), s[2].y()}))));
-  const int y1 = std::min(image.height - 1,
-                          static_cast<int>(std::ceil(std::max({s[0].y(), s[1].y(), s[2].y()}))));
-  for (int y = y0; y <= y1; ++y)
-    for (int x = x0; x <= x1; ++x) {
+  const PixelSpan xs = pixel_span(std::min({s[0].x(), s[1].x(), s[2].x()}),
+                                  std::max({s[0].x(), s[1].x(), s[2].x()}), frame.image.width);
+  const PixelSpan ys = pixel_span(std::min({s[0].y(), s[1].y(), s[2].y()}),
+                                  std::max({s[0].y(), s[1].y(), s[2].y()}), frame.image.height);
+  for (int y = ys.first; y <= ys.last; ++y)
+    for (int x = xs.first; x <= xs.last; ++x) {
       const double px = x + 0.5, py = y + 0.5;
       // Screen-space barycentrics; all >= 0 inside, whatever the winding.
       const Eigen::Vector3d b(edge(s[1], s[2], px, py) / area, edge(s[2], s[0], px, py) / area,
@@ -187,12 +182,10 @@ Image render_points(const Block<double>& points, const Block<double>& colours, c
     if (!(s.z() > options.near) || !s.allFinite()) continue;
     const Colour colour =
         colours.rows() > 0 ? Colour(colours.row(n).transpose()) : colours::grey(0.25);
-    const int x0 = std::max(0, static_cast<int>(std::floor(s.x() - radius)));
-    const int x1 = std::min(frame.image.width - 1, static_cast<int>(std::ceil(s.x() + radius)));
-    const int y0 = std::max(0, static_cast<int>(std::floor(s.y() - radius)));
-    const int y1 = std::min(frame.image.height - 1, static_cast<int>(std::ceil(s.y() + radius)));
-    for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x)
+    const PixelSpan xs = pixel_span(s.x() - radius, s.x() + radius, frame.image.width);
+    const PixelSpan ys = pixel_span(s.y() - radius, s.y() + radius, frame.image.height);
+    for (int y = ys.first; y <= ys.last; ++y)
+      for (int x = xs.first; x <= xs.last; ++x)
         if (std::hypot(x + 0.5 - s.x(), y + 0.5 - s.y()) <= radius)
           frame.write(x, y, s.z(), colour);
   }

@@ -120,6 +120,24 @@ TEST_CASE("shapes cover the expected area", "[image]") {
   CHECK(ink == Approx(60 * 3 + M_PI * 1.5 * 1.5).epsilon(0.05));
 }
 
+TEST_CASE("pixel_span clips huge, infinite and NaN bounds", "[image]") {
+  CHECK(jsa::pixel_span(-1e300, 1e300, 10).first == 0);
+  CHECK(jsa::pixel_span(-1e300, 1e300, 10).last == 9);
+  CHECK(jsa::pixel_span(2.5, 3.5, 10).first == 2);
+  CHECK(jsa::pixel_span(2.5, 3.5, 10).last == 4);
+  const jsa::PixelSpan outside = jsa::pixel_span(20, 30, 10), nan = jsa::pixel_span(NAN, 3, 10);
+  CHECK(outside.first > outside.last);
+  CHECK(nan.first > nan.last);
+  // Shapes with such coordinates draw what is on screen and nothing else.
+  jsa::Image image(20, 20);
+  jsa::fill_triangle(image, {-1e18, -1e18}, {1e18, -1e18}, {0, 1e18}, jsa::colours::black());
+  CHECK(image.get(10, 10) == jsa::colours::black());
+  jsa::draw_line(image, {NAN, 0}, {5, 5}, jsa::colours::red());
+  jsa::fill_circle(image, {INFINITY, 3}, 2, jsa::colours::red());
+  CHECK(jsa::sample_texture(jsa::checkerboard(8, 2), 1e300, -1e300) ==
+        jsa::checkerboard(8, 2).get(7, 7));
+}
+
 TEST_CASE("font: every printable character has a glyph that draws ink", "[image]") {
   std::set<std::vector<std::uint8_t>> distinct;
   for (char c = ' '; c <= '~'; ++c) {

@@ -124,6 +124,19 @@ TEST_CASE("three_views frames a cube: visible, inside the border, all different"
   CHECK(count_pixels_not(views[0], jsa::colours::white()) > 0.7 * 96 * 96);
 }
 
+TEST_CASE("render_mesh survives vertices just in front of the near plane", "[raster]") {
+  // One vertex barely in front of the eye projects tens of thousands of pixels away.
+  jsa::Block<double> vertices(3, 3);
+  vertices << -0.5, -0.5, 0, 0.5, -0.5, 0, 1, 1,
+      3 - 0.0011;  // depth 0.0011, just past options.near
+  jsa::Faces faces(1, 3);
+  faces << 0, 1, 2;
+  const jsa::Image image =
+      jsa::render_mesh(vertices, faces, jsa::Block<double>(), {{0, 0, 3}, {0, 0, 0}, {0, 1, 0}, 40},
+                       flat_options(64));
+  CHECK(image.width == 64);
+}
+
 TEST_CASE("render_points: discs of the right size, nearer points in front", "[raster]") {
   jsa::Block<double> points(2, 3), colours(2, 3);
   points << 0, 0, 0, 0, 0, 1;  // the second is nearer the eye at z = 3
