@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numeric>
 
@@ -131,90 +132,115 @@ std::vector<int> augmenting_row_reduction(const Block<double>& cost, std::vector
   return still_free;
 }
 
-// Phase 3 for one free row: shortest augmenting path, price update, flip.
-// Scratch vectors are passed in so the loop over free rows allocates nothing.
-void augment(const Block<double>& cost, int start_row, Matching& m, std::vector<double>& distance,
-             std::vector<int>& predecessor, std::vector<int>& order) {
-  const int n = int(cost.rows());
-  const double* start = cost.data() + size_t(start_row) * n;
+// Scratch space for phase 3, allocated once per solve. Every loop over the
+// columns runs over all n of them, contiguous, so the compiler can vectorize
+// it; settled columns are masked out by `closed` instead of being skipped.
+struct PathSearch {
+  explicit PathSearch(int n) : distance(n), closed(n), predecessor(n) { settled.reserve(n); }
+  std::vector<double> distance;  // shortest alternating-path length to each column
+  std::vector<double> closed;    // 0 while a column is open, +inf once settled
+  std::vector<int> predecessor;  // the row before each column on its shortest path
+  std::vector<int> settled;      // settled columns, in order
+};
+
+// path_length(j) = c_rj - v_j - offset; keep it where it beats distance[j] on
+// an open column. __restrict: the five arrays never overlap.
+void relax(const double* __restrict c, const double* __restrict price, double offset, int row,
+           double* __restrict distance, const double* __restrict closed,
+           int* __restrict predecessor, int n) {
   for (int j = 0; j < n; ++j) {
-    distance[j] = start[j] - m.price[j];
-    predecessor[j] = start_row;
-    order[j] = j;
+    const double length = c[j] - price[j] - offset;
+    const bool shorter = length + closed[j] < distance[j];
+    distance[j] = shorter ? length : distance[j];
+    predecessor[j] = shorter ? row : predecessor[j];
   }
-  // Columns are kept in three runs of `order`:
-  //   [0, settled)              settled: final distance (Dijkstra's closed set)
-  //   [settled, frontier_end)   distance == nearest, waiting to be scanned
-  //   [frontier_end, n)         not reached at the minimum yet
-  int settled = 0, frontier_end = 0;
-  double nearest = 0;
+}
+
+// argmin_j distance[j] over the open columns, the lowest index among ties.
+// Kept in 8 lanes (lane l sees columns j = l mod 8) so the loop vectorizes;
+// strict < keeps each lane's first minimum, and the merge its lowest index.
+int nearest_open_column(const double* __restrict distance, const double* __restrict closed, int n) {
+  constexpr int kLanes = 8;
+  double lane_distance[kLanes];
+  int64_t lane_column[kLanes];  // 64-bit, like the doubles, so lanes line up
+  for (int l = 0; l < kLanes; ++l) {
+    lane_distance[l] = kInfinity;
+    lane_column[l] = n;
+  }
+  int j = 0;
+  for (; j + kLanes <= n; j += kLanes)
+    for (int l = 0; l < kLanes; ++l) {
+      const double key = distance[j + l] + closed[j + l];
+      const bool nearer = key < lane_distance[l];
+      lane_distance[l] = nearer ? key : lane_distance[l];
+      lane_column[l] = nearer ? int64_t(j + l) : lane_column[l];
+    }
+  for (; j < n; ++j) {  // the last n mod 8 columns, in their lanes
+    const double key = distance[j] + closed[j];
+    const int l = j % kLanes;
+    if (key < lane_distance[l]) {
+      lane_distance[l] = key;
+      lane_column[l] = j;
+    }
+  }
+  double best = kInfinity;
+  int64_t column = n;
+  for (int l = 0; l < kLanes; ++l)
+    if (lane_distance[l] < best || (lane_distance[l] == best && lane_column[l] < column)) {
+      best = lane_distance[l];
+      column = lane_column[l];
+    }
+  return int(column);
+}
+
+// Phase 3 for one free row: Dijkstra over the columns, from `start_row`, until
+// the nearest open column is free; then the price update and the flip.
+void augment(const Block<double>& cost, int start_row, Matching& m, PathSearch& s) {
+  const int n = int(cost.rows());
+  std::fill(s.distance.begin(), s.distance.end(), kInfinity);
+  std::fill(s.closed.begin(), s.closed.end(), 0.0);
+  s.settled.clear();
+  // Path length to column j through row r: (length to r's column) + reduced
+  // cost c_rj - v_j - u_r = c_rj - v_j - offset. For the start row offset = 0.
+  int row = start_row;
+  double offset = 0, nearest = 0;
   int free_column = -1;
   while (free_column < 0) {
-    if (frontier_end == settled) {
-      // Collect every unsettled column at the smallest distance.
-      nearest = distance[order[settled]];
-      frontier_end = settled + 1;
-      for (int k = settled + 1; k < n; ++k) {
-        const int j = order[k];
-        if (distance[j] <= nearest) {
-          if (distance[j] < nearest) {
-            nearest = distance[j];
-            frontier_end = settled;
-          }
-          std::swap(order[k], order[frontier_end++]);
-        }
-      }
-      for (int k = settled; k < frontier_end; ++k)
-        if (m.row_of_column[order[k]] < 0) {
-          free_column = order[k];
-          break;
-        }
-      if (free_column >= 0) break;
-    }
-    // Settle one frontier column and relax the edges out of the row holding it.
-    const int column = order[settled++];
-    const int row = m.row_of_column[column];
     const double* c = cost.data() + size_t(row) * n;
-    // Path length to j through `row`: nearest + reduced cost c_rj - v_j - u_r,
-    // with u_r = c_{r,column} - v_column (the row's held column is its best).
-    const double offset = c[column] - m.price[column] - nearest;
-    for (int k = frontier_end; k < n; ++k) {
-      const int j = order[k];
-      const double length = c[j] - m.price[j] - offset;
-      if (length < distance[j]) {
-        distance[j] = length;
-        predecessor[j] = row;
-        if (length == nearest) {
-          if (m.row_of_column[j] < 0) {
-            free_column = j;
-            break;
-          }
-          std::swap(order[k], order[frontier_end++]);
-        }
-      }
+    relax(c, m.price.data(), offset, row, s.distance.data(), s.closed.data(), s.predecessor.data(),
+          n);
+    // With ties the lowest column wins, free or not: a free column at the same
+    // distance stays open at `nearest` and is taken on a following step.
+    const int column = nearest_open_column(s.distance.data(), s.closed.data(), n);
+    nearest = s.distance[column];
+    if (m.row_of_column[column] < 0) {
+      free_column = column;
+    } else {
+      s.closed[column] = kInfinity;
+      s.settled.push_back(column);
+      row = m.row_of_column[column];
+      // u_row = c_{row,column} - v_column: the row's held column is its best.
+      offset = cost(row, column) - m.price[column] - nearest;
     }
   }
   // Settled columns: v_j += d_j - nearest (<= 0). Their rows' reduced costs
   // keep 0 on the held column and stay >= 0 elsewhere (Dijkstra's optimality).
-  for (int k = 0; k < settled; ++k) {
-    const int j = order[k];
-    m.price[j] += distance[j] - nearest;
-  }
+  for (int j : s.settled) m.price[j] += s.distance[j] - nearest;
   // Flip the alternating path back from the free column to the start row.
   int column = free_column;
   for (;;) {
-    const int row = predecessor[column];
-    m.row_of_column[column] = row;
-    std::swap(column, m.column_of_row[row]);
-    if (row == start_row) break;
+    const int r = s.predecessor[column];
+    m.row_of_column[column] = r;
+    std::swap(column, m.column_of_row[r]);
+    if (r == start_row) break;
   }
 }
 
 }  // namespace
 
 Assignment assign_lapjv(const Block<double>& cost) {
-  JSA_CHECK(cost.rows() == cost.cols(), "assignment needs a square cost matrix, got "
-                                            << cost.rows() << " x " << cost.cols());
+  JSA_CHECK(cost.rows() == cost.cols(),
+            "assignment needs a square cost matrix, got " << cost.rows() << " x " << cost.cols());
   JSA_CHECK(cost.rows() < std::numeric_limits<int>::max(), "cost matrix too large");
   JSA_CHECK(cost.allFinite(), "assignment costs must be finite");
   const int n = int(cost.rows());
@@ -232,9 +258,8 @@ Assignment assign_lapjv(const Block<double>& cost) {
     long bid_budget = 16L * n;
     for (int pass = 0; pass < 2 && !free_rows.empty(); ++pass)
       free_rows = augmenting_row_reduction(cost, std::move(free_rows), m, bid_budget);
-    std::vector<double> distance(n);
-    std::vector<int> predecessor(n), order(n);
-    for (int row : free_rows) augment(cost, row, m, distance, predecessor, order);
+    PathSearch search(n);
+    for (int row : free_rows) augment(cost, row, m, search);
   }
   result.column_of_row = m.column_of_row;
   result.column_dual = m.price;

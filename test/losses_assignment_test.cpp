@@ -172,8 +172,8 @@ TEST_CASE("LAPJV and auction agree exactly on integer-scaled squared distances",
     t0 = std::chrono::steady_clock::now();
     const IntegerAssignment auction = assign_auction(ci);
     const double auction_seconds = seconds_since(t0);
-    std::printf("n = %d: LAPJV %.3f s, auction %.3f s (%d phases, %lld bids)\n", n,
-                lapjv_seconds, auction_seconds, auction.phases, (long long)auction.bids);
+    std::printf("n = %d: LAPJV %.3f s, auction %.3f s (%d phases, %lld bids)\n", n, lapjv_seconds,
+                auction_seconds, auction.phases, (long long)auction.bids);
     REQUIRE(is_permutation_of_n(auction.column_of_row));
     CHECK(double(auction.cost) == exact.cost);
     CHECK(cost_of(cd, auction.column_of_row) == exact.cost);
