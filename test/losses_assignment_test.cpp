@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <cstdio>
+#include <limits>
 #include <numeric>
 
 #include "engine/check.h"
@@ -157,6 +158,60 @@ TEST_CASE("auction matches brute force on small integer matrices", "[assignment]
     REQUIRE(is_permutation_of_n(a.column_of_row));
     CHECK(double(a.cost) == assign_brute_force(c).cost);
   }
+}
+
+TEST_CASE("LAPJV and auction agree on larger matrices full of ties", "[assignment]") {
+  // Few distinct values: many optimal matchings, many equal reduced costs, the
+  // tie branches of both algorithms; the optimal cost is still unique.
+  Rng rng(31);
+  for (int levels : {2, 5, 1000}) {
+    for (int n : {60, 300}) {
+      const Block<double> c = tied_costs(n, levels, rng);
+      const Assignment exact = assign_lapjv(c);
+      const IntegerAssignment auction = assign_auction(integer_costs(c, 1.0));
+      INFO("n = " << n << ", levels = " << levels);
+      REQUIRE(is_permutation_of_n(exact.column_of_row));
+      REQUIRE(is_permutation_of_n(auction.column_of_row));
+      CHECK(double(auction.cost) == exact.cost);
+      CHECK(check_certificate(c, exact).proves_optimal(0.0));
+    }
+  }
+}
+
+TEST_CASE("LAPJV stays exact when costs span many orders of magnitude", "[assignment]") {
+  // Entries k * 1e16 + uniform[0, 1): near 1e16 a double's spacing is 2, so
+  // price updates round and small price drops vanish (the case the bid budget
+  // and the "drop rounded away" branch are there for). The solver must still
+  // stop and be optimal up to that rounding.
+  Rng rng(47);
+  for (int r = 0; r < 200; ++r) {
+    const int n = 2 + int(rng.below(7));
+    Block<double> c(n, n);
+    for (Index k = 0; k < c.size(); ++k) c.data()[k] = 1e16 * double(rng.below(3)) + rng.uniform();
+    const Assignment fast = assign_lapjv(c), oracle = assign_brute_force(c);
+    INFO("n = " << n << "\n" << c);
+    REQUIRE(is_permutation_of_n(fast.column_of_row));
+    CHECK(fast.cost == Approx(oracle.cost).margin(8 * n));  // a few spacings per row
+  }
+  const int n = 300;
+  Block<double> c(n, n);
+  for (Index k = 0; k < c.size(); ++k) c.data()[k] = 1e16 * double(rng.below(3)) + rng.uniform();
+  const Assignment a = assign_lapjv(c);
+  REQUIRE(is_permutation_of_n(a.column_of_row));
+  CHECK(check_certificate(c, a).max_dual_violation <= 64.0);  // ~ spacing 2 times a few roundings
+}
+
+TEST_CASE("auction refuses costs that could overflow, integer_costs non-finite input",
+          "[assignment]") {
+  Block<int64_t> huge = Block<int64_t>::Zero(100, 100);
+  huge(3, 7) = int64_t(1) << 50;  // times (n + 1)^2 ~ 2^63.3: too large
+  CHECK_THROWS_AS(assign_auction(huge), InternalError);
+  huge(3, 7) = int64_t(1) << 40;  // ~ 2^53.3: fine
+  CHECK(assign_auction(huge).cost == 0);
+  Block<double> c = Block<double>::Zero(2, 2);
+  c(1, 1) = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_AS(integer_costs(c, 1.0), InternalError);
+  CHECK_THROWS_AS(assign_lapjv(c), InternalError);
 }
 
 TEST_CASE("LAPJV and auction agree exactly on integer-scaled squared distances", "[assignment]") {
