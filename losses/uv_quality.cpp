@@ -389,8 +389,8 @@ std::string to_text(const UvQuality& q) {
   std::ostringstream s;
   auto row = [&](const char* name, const std::string& value, const char* ideal) {
     char line[160];
-    std::snprintf(line, sizeof line, "  %-22s %14s   %s\n", name, value.c_str(), ideal);
-    s << line;
+    std::snprintf(line, sizeof line, "  %-22s %14s", name, value.c_str());
+    s << line << (*ideal ? "   " : "") << ideal << "\n";
   };
   auto num = [](double v) {
     char b[64];
