@@ -251,6 +251,77 @@ TEST_CASE("uv quality: uv = (2x, y) has singular values sqrt2 and 1/sqrt2", "[uv
   CHECK(q.torn == 0);
 }
 
+TEST_CASE("uv quality: distortion of random triangles against Sander's formulas and an SVD",
+          "[uv]") {
+  // Separate random triangles, random UVs. Oracle: Sander et al.'s explicit
+  // S_s, S_t (their Eq. 1, with the scaled UVs), then Eigen's SVD of [S_s, S_t],
+  // independent of the closed-form eigenvalues the library uses.
+  Rng rng(11);
+  const int F = 12;
+  UvMesh m;
+  m.positions.resize(3 * F, 3);
+  m.uv.resize(3 * F, 2);
+  for (Index i = 0; i < m.positions.size(); ++i) m.positions.data()[i] = rng.uniform(-1, 1);
+  for (Index i = 0; i < m.uv.size(); ++i) m.uv.data()[i] = rng.uniform(0, 1);
+  m.faces.resize(F, 3);
+  for (int f = 0; f < F; ++f) m.faces.row(f) << 3 * f, 3 * f + 1, 3 * f + 2;
+  m.uv_faces = m.faces;
+  UvQualityOptions o;
+  o.torn_ratio = 1e9;  // judge every triangle, however skewed
+  const UvQuality q = measure(m, o);
+  REQUIRE(q.measured == F);
+
+  double area3 = 0, area_uv = 0;
+  for (int f = 0; f < F; ++f) {
+    const Eigen::Vector3d p0 = m.positions.row(3 * f), p1 = m.positions.row(3 * f + 1);
+    const Eigen::Vector3d p2 = m.positions.row(3 * f + 2);
+    const Eigen::Vector2d e1 = m.uv.row(3 * f + 1) - m.uv.row(3 * f);
+    const Eigen::Vector2d e2 = m.uv.row(3 * f + 2) - m.uv.row(3 * f);
+    area3 += 0.5 * (p1 - p0).cross(p2 - p0).norm();
+    area_uv += 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
+  }
+  const double k = std::sqrt(area3 / area_uv);
+  double l2 = 0, linf = 0, dirichlet = 0, conformal = 0;
+  for (int f = 0; f < F; ++f) {
+    Eigen::Vector3d p[3];
+    double s[3], t[3];
+    for (int c = 0; c < 3; ++c) {
+      p[c] = m.positions.row(3 * f + c).transpose();
+      s[c] = k * m.uv(3 * f + c, 0);
+      t[c] = k * m.uv(3 * f + c, 1);
+    }
+    const double two_a = (s[1] - s[0]) * (t[2] - t[0]) - (s[2] - s[0]) * (t[1] - t[0]);
+    const Eigen::Vector3d Ss =
+        (p[0] * (t[1] - t[2]) + p[1] * (t[2] - t[0]) + p[2] * (t[0] - t[1])) / two_a;
+    const Eigen::Vector3d St =
+        (p[0] * (s[2] - s[1]) + p[1] * (s[0] - s[2]) + p[2] * (s[1] - s[0])) / two_a;
+    Eigen::Matrix<double, 3, 2> J;
+    J << Ss, St;
+    const Eigen::Vector2d sv = Eigen::JacobiSVD<Eigen::Matrix<double, 3, 2>>(J).singularValues();
+    const double w = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
+    const double G = sv(0), g = sv(1);
+    l2 += w * (G * G + g * g) / 2;
+    linf = std::max(linf, G);
+    dirichlet += w * (G * G + g * g + 1 / (G * G) + 1 / (g * g));
+    conformal += w * G / g;
+  }
+  CHECK(q.stretch_l2 == Approx(std::sqrt(l2 / area3)).epsilon(1e-9));
+  CHECK(q.stretch_linf == Approx(linf).epsilon(1e-9));
+  CHECK(q.symmetric_dirichlet == Approx(dirichlet / area3).epsilon(1e-9));
+  CHECK(q.conformal_distortion == Approx(conformal / area3).epsilon(1e-9));
+  CHECK(q.conformal_distortion > 1.2);  // far from conformal: the check is not vacuous
+
+  SECTION("and the same numbers for UVs in other units") {
+    UvMesh scaled = m;
+    scaled.uv *= 1e-3;
+    const UvQuality r = measure(scaled, o);
+    CHECK(r.stretch_l2 == Approx(q.stretch_l2).epsilon(1e-9));
+    CHECK(r.stretch_linf == Approx(q.stretch_linf).epsilon(1e-9));
+    CHECK(r.symmetric_dirichlet == Approx(q.symmetric_dirichlet).epsilon(1e-9));
+    CHECK(r.conformal_distortion == Approx(q.conformal_distortion).epsilon(1e-9));
+  }
+}
+
 TEST_CASE("uv quality: one flipped triangle is found with its share of the area", "[uv]") {
   // Face 2 * (1 * 4 + 1) lies in cell (1, 1), away from the border. Its own UV
   // rows with corners 0 and 1 swapped: same UV footprint, opposite orientation.
