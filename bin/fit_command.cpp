@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <vector>
 #include <sstream>
 
 #include "bin/commands.h"
@@ -24,7 +25,8 @@ std::atomic<int> g_signal{0};
 extern "C" void on_signal(int s) { g_signal = s; }
 
 struct FitArgs {
-  std::string input, out_dir, resume;
+  std::vector<std::string> inputs;
+  std::string list_file, out_dir, resume;
   FitOptions options;
   int threads = 0;
   int checkpoint_every = 500;
@@ -49,16 +51,26 @@ std::string format_duration(double seconds) {
 void run_fit(FitArgs& a) {
   namespace fs = std::filesystem;
   FitOptions o = a.options;
-  std::string input = a.input;
+  std::vector<std::string> inputs = a.inputs;
+  if (!a.list_file.empty()) {
+    std::ifstream in(a.list_file);
+    if (!in) throw InputError(a.list_file + ": cannot open the list of inputs");
+    std::string line;
+    while (std::getline(in, line)) {
+      const auto b = line.find_first_not_of(" \t\r"), e = line.find_last_not_of(" \t\r");
+      if (b != std::string::npos && line[b] != '#') inputs.push_back(line.substr(b, e - b + 1));
+    }
+    if (inputs.empty()) throw InputError(a.list_file + ": lists no inputs");
+  }
   CheckpointContents resumed;
   const bool resuming = !a.resume.empty();
   if (resuming) {
     a.out_dir = a.resume;
     resumed = read_checkpoint((fs::path(a.resume) / "model.ckpt").string());
     o = fit_options_from_json(resumed.settings_json, a.resume + "/model.ckpt");
-    input = resumed.input;
+    inputs = resumed.inputs;
   } else {
-    if (input.empty()) throw InputError("fit: give an INPUT (a mesh, a point cloud or builtin:NAME) or --resume DIR");
+    if (inputs.empty()) throw InputError("fit: give an INPUT (a mesh, a point cloud or builtin:NAME) or --resume DIR");
     if (a.out_dir.empty()) throw InputError("fit: give an output directory with -o DIR");
     if (!a.preset.empty()) {
       if (a.preset != "paper") throw InputError("--preset: unknown preset '" + a.preset + "' (known: paper)");
@@ -76,28 +88,40 @@ void run_fit(FitArgs& a) {
   }
   set_threads(a.threads);
 
-  // The shape, a fixed pool of surface samples, and the unit frame (Sec. 4 data).
-  RunInput shape = load_run_input(input, a.pool, o.seed);
-  if (resuming) shape.normalization = resumed.normalization;
+  // Each shape, a fixed pool of surface samples, and its unit frame (Sec. 4 data).
+  std::vector<RunInput> shapes;
+  std::vector<Block<double>> pools;
+  std::vector<Normalization> frames;
+  for (size_t i = 0; i < inputs.size(); ++i) {
+    shapes.push_back(load_run_input(inputs[i], a.pool, o.seed + 1000 * i));
+    if (resuming) shapes.back().normalization = resumed.normalizations[i];
+    pools.push_back(shapes.back().pool);
+    frames.push_back(shapes.back().normalization);
+    for (const std::string& w : shapes.back().mesh.warnings)
+      if (!a.quiet) std::cerr << "warning: " << inputs[i] << ": " << w << "\n";
+  }
+  o.atlas.shapes = int(inputs.size());
   fs::create_directories(a.out_dir);
   const std::string dir = a.out_dir;
   write_file_atomically(dir + "/config.json", [&](std::ostream& out) {
-    out << "{\n\"input\": " << json_quote(input) << ",\n\"settings\": " << fit_options_to_json(o) << "\n}\n";
+    out << "{\n\"inputs\": [";
+    for (size_t i = 0; i < inputs.size(); ++i) out << (i ? ", " : "") << json_quote(inputs[i]);
+    out << "],\n\"settings\": " << fit_options_to_json(o) << "\n}\n";
   });
 
-  Trainer trainer(o, shape.pool);
+  Trainer trainer(o, pools);
   LossLog log;
   if (resuming) {
     restore_trainer(trainer, resumed, a.resume);
     log = read_loss_log(dir + "/losses.csv", trainer.iteration());
   }
   if (!a.quiet)
-    std::cerr << "fit: " << input << " -> " << dir << "  (" << o.iterations << " iterations, M = " << o.points
+    std::cerr << "fit: " << (inputs.size() == 1 ? inputs[0] : std::to_string(inputs.size()) + " shapes") << " -> " << dir << "  (" << o.iterations << " iterations, M = " << o.points
               << ", K = " << o.atlas.gaussians << ", MLP " << o.atlas.hidden_layers << "x" << o.atlas.width
               << ", " << max_threads() << " threads" << (resuming ? ", resumed at " + std::to_string(trainer.iteration()) : std::string()) << ")\n";
 
   auto save = [&]() {
-    write_checkpoint(dir + "/model.ckpt", input, o, shape.normalization, trainer);
+    write_checkpoint(dir + "/model.ckpt", inputs, o, frames, trainer);
     write_loss_log(dir + "/losses.csv", log);
   };
   std::signal(SIGINT, on_signal);
@@ -140,7 +164,7 @@ void run_fit(FitArgs& a) {
     }
   }
   save();
-  write_run_outputs(trainer.atlas(), shape, log, dir, MeshOutputOptions{a.mesh_resolution, a.mesh_threshold, a.quiet});
+  write_run_outputs(trainer.atlas(), shapes, log, dir, MeshOutputOptions{a.mesh_resolution, a.mesh_threshold, a.quiet});
   if (!a.quiet)
     std::cerr << "fit: done in " << format_duration(std::chrono::duration<double>(clock::now() - start).count())
               << "; results in " << dir << "\n";
@@ -152,7 +176,10 @@ void add_fit(CLI::App& app) {
   auto a = std::make_shared<FitArgs>();
   FitOptions& o = a->options;
   CLI::App* c = app.add_subcommand("fit", "Learn the atlas of a shape: domain P, parametrization phi, chart psi");
-  c->add_option("input", a->input, "Mesh (.obj .off .ply), oriented point cloud (.ply with normals, .xyz x y z nx ny nz), or builtin:NAME (sphere, torus, cube, ...)");
+  c->add_option("inputs", a->inputs, "Mesh (.obj .off .ply), oriented point cloud (.ply with normals, .xyz x y z nx ny nz), or builtin:NAME (sphere, torus, cube, capsule); several inputs fit a collection with one shared domain (Sec. 3.4)");
+  c->add_option("--list", a->list_file, "A file naming one input per line (collections)");
+  c->add_option("--code-size", o.atlas.code_size, "Collections: width of the latent codes f_phi,i and f_psi,i")->capture_default_str()->check(CLI::Range(1, 4096));
+  c->add_option("--w-code", o.weights.code, "Collections: weight of the mean squared norm of the codes")->capture_default_str()->check(CLI::NonNegativeNumber);
   c->add_option("-o,--out", a->out_dir, "Output directory (created if needed)");
   c->add_option("--resume", a->resume, "Continue the run in DIR from its model.ckpt (settings come from the checkpoint)");
   c->add_option("--iters", o.iterations, "Training iterations")->capture_default_str()->check(CLI::Range(int64_t(0), int64_t(100000000)));

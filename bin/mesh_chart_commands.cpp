@@ -27,14 +27,21 @@ LoadedRun load_run(const std::string& run) {
 struct MeshArgs {
   std::string run, out;
   MeshOutputOptions options;
-  int threads = 0;
+  int threads = 0, shape = 0;
 };
 
 struct ChartArgs {
   std::string run, input, out;
   ChartOutputOptions options;
-  int threads = 0;
+  int threads = 0, shape = 0;
 };
+
+int checked_shape(const LoadedRun& r, int shape) {
+  if (shape < 0 || shape >= int(r.contents.inputs.size()))
+    throw InputError("--shape " + std::to_string(shape) + ": the run has " +
+                     std::to_string(r.contents.inputs.size()) + " shape(s), numbered from 0");
+  return shape;
+}
 
 }  // namespace
 
@@ -46,11 +53,13 @@ void add_mesh(CLI::App& app) {
   c->add_option("--resolution", a->options.resolution, "Grid cells across the domain")->capture_default_str()->check(CLI::Range(8, 4096));
   c->add_option("--threshold", a->options.threshold, "Domain = {P >= t * median of P at the means}")->capture_default_str()->check(CLI::Range(0.0, 100.0));
   c->add_option("--threads", a->threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
+  c->add_option("--shape", a->shape, "Which shape of a collection (0-based)")->capture_default_str();
   c->add_flag("-q,--quiet", a->options.quiet, "No report on the terminal");
   c->callback([a]() {
     set_threads(a->threads);
     LoadedRun r = load_run(a->run);
-    write_domain_mesh(*r.atlas, r.contents.normalization, a->out, a->options);
+    const int i = checked_shape(r, a->shape);
+    write_domain_mesh(*r.atlas, r.contents.normalizations[size_t(i)], a->out, a->options, i);
   });
 }
 
@@ -63,12 +72,14 @@ void add_chart(CLI::App& app) {
   c->add_flag("--split-cuts", a->options.split_cuts, "Give triangles torn across the cut their own UV corners");
   c->add_option("--torn-ratio", a->options.torn_ratio, "A UV edge this many times longer than its 3D edge (areas equalised) is torn")->capture_default_str()->check(CLI::Range(1.0, 1e6));
   c->add_option("--threads", a->threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
+  c->add_option("--shape", a->shape, "Which shape of a collection (0-based)")->capture_default_str();
   c->add_flag("-q,--quiet", a->options.quiet, "No report on the terminal");
   c->callback([a]() {
     set_threads(a->threads);
     LoadedRun r = load_run(a->run);
-    const Mesh mesh = load_shape(a->input.empty() ? r.contents.input : a->input);
-    write_chart(*r.atlas, r.contents.normalization, mesh, a->out, a->options);
+    const int i = checked_shape(r, a->shape);
+    const Mesh mesh = load_shape(a->input.empty() ? r.contents.inputs[size_t(i)] : a->input);
+    write_chart(*r.atlas, r.contents.normalizations[size_t(i)], mesh, a->out, a->options, i);
   });
 }
 

@@ -11,6 +11,7 @@
 #include "model/chart_mesh.h"
 #include "model/domain_mesh.h"
 #include "model/pictures.h"
+#include "io/raster.h"
 
 namespace jsa::cli {
 namespace {
@@ -44,13 +45,13 @@ void write_report(const std::string& path, const UvQuality& q, const nlohmann::j
 std::string json_quote(const std::string& s) { return nlohmann::json(s).dump(); }
 
 void write_domain_mesh(Atlas<float>& atlas, const Normalization& normalization,
-                       const std::string& obj_path, const MeshOutputOptions& o) {
+                       const std::string& obj_path, const MeshOutputOptions& o, int shape) {
   const DomainMesh dm = mesh_domain(atlas, DomainMeshOptions{o.resolution, o.threshold});
   if (dm.faces.rows() == 0)
     throw InputError("mesh: no domain above the threshold " + std::to_string(o.threshold) + " (lower --threshold)");
   Mesh out;
   Block<double> points, normals;
-  evaluate_surface(atlas, dm.uv, points, normals);
+  evaluate_surface(atlas, dm.uv, points, normals, shape);
   out.vertices = normalization.from_unit(points);
   out.normals = normals;
   out.faces = dm.faces;
@@ -69,9 +70,9 @@ void write_domain_mesh(Atlas<float>& atlas, const Normalization& normalization,
 }
 
 void write_chart(Atlas<float>& atlas, const Normalization& normalization, const Mesh& mesh,
-                 const std::string& obj_path, const ChartOutputOptions& o) {
+                 const std::string& obj_path, const ChartOutputOptions& o, int shape) {
   if (mesh.faces.rows() == 0) throw InputError("chart: the input has no faces (a point cloud has no UV map to write)");
-  const Block<double> uv = chart_vertices(atlas, mesh, normalization);
+  const Block<double> uv = chart_vertices(atlas, mesh, normalization, shape);
   const TextureFrame frame = texture_frame(atlas);
   Block<double> vt = frame.to_texture(uv);
   UvQualityOptions qo;
@@ -80,7 +81,7 @@ void write_chart(Atlas<float>& atlas, const Normalization& normalization, const 
   Faces uv_faces = mesh.faces;
   const Index torn_before = q.torn;
   if (o.split_cuts && q.torn > 0) {
-    SplitUv split = split_torn(atlas, mesh, normalization, uv, q.torn_faces);
+    SplitUv split = split_torn(atlas, mesh, normalization, uv, q.torn_faces, shape);
     vt = frame.to_texture(split.uv);
     uv_faces = split.uv_faces;
     q = measure_uv_quality(mesh.vertices, mesh.faces, vt, uv_faces, qo);
@@ -103,13 +104,37 @@ void write_chart(Atlas<float>& atlas, const Normalization& normalization, const 
   }
 }
 
-void write_run_outputs(Atlas<float>& atlas, const RunInput& input, const LossLog& log,
+void write_run_outputs(Atlas<float>& atlas, const std::vector<RunInput>& inputs, const LossLog& log,
                        const std::string& dir, const MeshOutputOptions& mesh) {
-  write_domain_mesh(atlas, input.normalization, dir + "/domain_mesh.obj", mesh);
-  if (input.mesh.faces.rows() > 0) {
-    ChartOutputOptions co;
-    co.quiet = mesh.quiet;
-    write_chart(atlas, input.normalization, input.mesh, dir + "/input_chart.obj", co);
+  const bool collection = inputs.size() > 1;
+  std::vector<Image> coloured;
+  std::vector<std::string> captions;
+  for (size_t i = 0; i < inputs.size(); ++i) {
+    const std::string sub = collection ? dir + "/shape_" + std::to_string(i) : dir;
+    if (collection) {
+      fs::create_directories(sub);
+      if (!mesh.quiet) std::cerr << "shape " << i << ":\n";
+    }
+    write_domain_mesh(atlas, inputs[i].normalization, sub + "/domain_mesh.obj", mesh, int(i));
+    if (inputs[i].mesh.faces.rows() > 0) {
+      ChartOutputOptions co;
+      co.quiet = mesh.quiet;
+      write_chart(atlas, inputs[i].normalization, inputs[i].mesh, sub + "/input_chart.obj", co, int(i));
+      if (collection) {
+        // One view per shape, coloured by its position in the shared domain.
+        const Mesh& m = inputs[i].mesh;
+        const Block<double> vt =
+            texture_frame(atlas).to_texture(chart_vertices(atlas, m, inputs[i].normalization, int(i)));
+        coloured.push_back(domain_coloured_views(m.vertices, m.faces, vt, 320));
+        captions.push_back("shape " + std::to_string(i));
+      }
+    }
+  }
+  if (collection && !coloured.empty()) {
+    GridOptions g;
+    g.columns = 1;
+    g.captions = captions;
+    write_png(dir + "/collection.png", compose_grid(coloured, g));
   }
   const DomainMesh dm = mesh_domain(atlas, DomainMeshOptions{64, mesh.threshold});
   write_png(dir + "/domain.png", domain_picture(atlas, dm.level));

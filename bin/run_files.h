@@ -20,7 +20,7 @@ struct MeshOutputOptions {
 // OUT.obj (+ .mtl, texture PNG, _uv.json report, .png three views): the
 // thresholded domain mapped through phi, in the input's frame.
 void write_domain_mesh(Atlas<float>& atlas, const Normalization& normalization,
-                       const std::string& obj_path, const MeshOutputOptions& o);
+                       const std::string& obj_path, const MeshOutputOptions& o, int shape = 0);
 
 struct ChartOutputOptions {
   bool split_cuts = false;  // give torn triangles their own UV corners (no smeared triangles)
@@ -30,11 +30,13 @@ struct ChartOutputOptions {
 // OUT.obj with the user's vertices and faces in their order and vt from psi,
 // OUT_uv.json, OUT.png (three views coloured through the chart), OUT_layout.png.
 void write_chart(Atlas<float>& atlas, const Normalization& normalization, const Mesh& mesh,
-                 const std::string& obj_path, const ChartOutputOptions& o);
+                 const std::string& obj_path, const ChartOutputOptions& o, int shape = 0);
 
 // Everything at the end of `fit`: domain_mesh.*, input_chart.* (for mesh
-// inputs), domain.png, losses.png.
-void write_run_outputs(Atlas<float>& atlas, const RunInput& input, const LossLog& log,
+// inputs), domain.png, losses.png; for a collection the per-shape files go to
+// DIR/shape_<i>/ and DIR/collection.png shows every shape coloured by the
+// shared domain.
+void write_run_outputs(Atlas<float>& atlas, const std::vector<RunInput>& inputs, const LossLog& log,
                        const std::string& dir, const MeshOutputOptions& mesh);
 
 }  // namespace jsa::cli

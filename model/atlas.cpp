@@ -1,12 +1,34 @@
 #include "model/atlas.h"
 
+#include "engine/ops.h"
+
 namespace jsa {
 
 template <class T>
 Atlas<T>::Atlas(const AtlasOptions& o) : options_(o) {
+  JSA_CHECK(o.shapes >= 1 && (o.shapes == 1 || o.code_size > 0), "bad collection size");
+  const int d = o.shapes > 1 ? o.code_size : 0;
   domain = Domain<T>(params, DomainOptions{o.gaussians, o.gaussian_noise});
-  phi = Parametrization<T>(params, MlpShape{2, 3, o.width, o.hidden_layers}, T(o.alpha));
-  psi = Chart<T>(params, MlpShape{6, 2, o.width, o.hidden_layers});
+  phi = Parametrization<T>(params, MlpShape{2, 3, o.width, o.hidden_layers, d}, T(o.alpha));
+  psi = Chart<T>(params, MlpShape{6, 2, o.width, o.hidden_layers, d});
+  if (d > 0) {
+    phi_codes_ = params.add("codes.phi", o.shapes, d);
+    psi_codes_ = params.add("codes.psi", o.shapes, d);
+  }
+}
+
+template <class T>
+Var Atlas<T>::phi_code(Tape<T>& t, int shape) {
+  if (phi_codes_ < 0) return Var{};
+  JSA_CHECK(shape >= 0 && shape < options_.shapes, "shape " << shape << " of " << options_.shapes);
+  return gather_rows(t, params.on(t, phi_codes_), {shape});
+}
+
+template <class T>
+Var Atlas<T>::psi_code(Tape<T>& t, int shape) {
+  if (psi_codes_ < 0) return Var{};
+  JSA_CHECK(shape >= 0 && shape < options_.shapes, "shape " << shape << " of " << options_.shapes);
+  return gather_rows(t, params.on(t, psi_codes_), {shape});
 }
 
 template <class T>
@@ -16,6 +38,14 @@ void Atlas<T>::initialize(Rng& rng) {
   domain.initialize(params, r_mu);
   phi.initialize(params, r_phi);
   psi.initialize(params, r_psi);
+  if (phi_codes_ >= 0) {
+    // DeepSDF's auto-decoder initialisation: small Gaussian codes.
+    Rng r_codes = rng.stream(4);
+    for (int b : {phi_codes_, psi_codes_}) {
+      auto c = params.value(b);
+      for (Index i = 0; i < c.size(); ++i) c.data()[i] = T(0.01 * r_codes.normal());
+    }
+  }
 }
 
 template class Atlas<float>;

@@ -16,6 +16,8 @@ struct AtlasOptions {
   int hidden_layers = 5;    // hidden layers of phi and psi (paper: 5)
   double alpha = 0.01;      // norm of the normals fed to psi and produced by phi6 (paper: 0.01)
   bool gaussian_noise = true;  // sample P (true) or the means alone (Table 1 rows 6-8)
+  int shapes = 1;           // N shapes sharing the domain (Sec. 3.4); > 1 adds latent codes
+  int code_size = 256;      // D, width of f_phi,i and f_psi,i when shapes > 1 (paper: 256)
 };
 
 template <class T>
@@ -25,7 +27,13 @@ class Atlas {
   Atlas(const Atlas&) = delete;  // tape closures point into params: the atlas stays put
   Atlas& operator=(const Atlas&) = delete;
 
-  void initialize(Rng& rng);  // mu ~ U[0,1]^2, MLPs as PyTorch's default
+  void initialize(Rng& rng);  // mu ~ U[0,1]^2, MLPs as PyTorch's default, codes ~ N(0, 0.01^2)
+
+  bool has_codes() const { return options_.shapes > 1; }
+  int shapes() const { return options_.shapes; }
+  // f_phi,i and f_psi,i (1 x D) of shape i on the tape; invalid Vars for a single shape.
+  Var phi_code(Tape<T>& t, int shape);
+  Var psi_code(Tape<T>& t, int shape);
 
   const AtlasOptions& options() const { return options_; }
   Parameters<T> params;
@@ -35,6 +43,7 @@ class Atlas {
 
  private:
   AtlasOptions options_;
+  int phi_codes_ = -1, psi_codes_ = -1;  // N x D parameter blocks
 };
 
 }  // namespace jsa

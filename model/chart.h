@@ -10,11 +10,13 @@ template <class T>
 class Chart {
  public:
   Chart() = default;
-  // in = 6 (+ latent code width for collections), out = 2.
+  // in = 6, out = 2 (code_size: the latent code width in a collection).
   Chart(Parameters<T>& params, const MlpShape& shape) : mlp_(params, "psi", shape) {}
   void initialize(Parameters<T>& params, Rng& rng) const { mlp_.initialize(params, rng); }
-  // x: M x in, [point, alpha n, code...] -> M x 2 domain coordinates.
-  Var evaluate(Tape<T>& t, Parameters<T>& params, Var x) const { return mlp_.forward(t, params, x); }
+  // x: M x 6 rows [point, alpha n] -> M x 2 domain coordinates; code: f_psi,i (1 x D) or none.
+  Var evaluate(Tape<T>& t, Parameters<T>& params, Var x, Var code = {}) const {
+    return mlp_.forward(t, params, x, -1, code);
+  }
   const Mlp<T>& mlp() const { return mlp_; }
 
  private:

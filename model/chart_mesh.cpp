@@ -15,28 +15,30 @@ Block<double> chart_input(const Atlas<float>& atlas, const Mesh& mesh, const Nor
   return in;
 }
 
-Block<double> psi(Atlas<float>& atlas, const Block<double>& x) {
+}  // namespace
+
+Block<double> chart_points(Atlas<float>& atlas, const Block<double>& x, int shape) {
   Block<double> uv(x.rows(), 2);
   Tape<float> t;
   const Index batch = 16384;
   for (Index b = 0; b < x.rows(); b += batch) {
     const Index n = std::min(batch, x.rows() - b);
     t.clear();
-    Var out = atlas.psi.evaluate(t, atlas.params, t.constant(x.middleRows(b, n).cast<float>()));
+    Var out = atlas.psi.evaluate(t, atlas.params, t.constant(x.middleRows(b, n).cast<float>()),
+                                 atlas.psi_code(t, shape));
     uv.middleRows(b, n) = t.value(out).cast<double>();
   }
   return uv;
 }
 
-}  // namespace
-
-Block<double> chart_vertices(Atlas<float>& atlas, const Mesh& mesh, const Normalization& normalization) {
+Block<double> chart_vertices(Atlas<float>& atlas, const Mesh& mesh, const Normalization& normalization,
+                             int shape) {
   if (mesh.vertices.rows() == 0) throw InputError("chart: the mesh has no vertices");
-  return psi(atlas, chart_input(atlas, mesh, normalization));
+  return chart_points(atlas, chart_input(atlas, mesh, normalization), shape);
 }
 
 SplitUv split_torn(Atlas<float>& atlas, const Mesh& mesh, const Normalization& normalization,
-                   const Block<double>& vertex_uv, const std::vector<int>& torn_faces) {
+                   const Block<double>& vertex_uv, const std::vector<int>& torn_faces, int shape) {
   const Block<double> in = chart_input(atlas, mesh, normalization);
   SplitUv out;
   out.uv_faces = mesh.faces;
@@ -53,7 +55,7 @@ SplitUv split_torn(Atlas<float>& atlas, const Mesh& mesh, const Normalization& n
     probes.row(3 * k + 1) = a + eps * (in.row(f(1)) - a);
     probes.row(3 * k + 2) = a + eps * (in.row(f(2)) - a);
   }
-  const Block<double> p = psi(atlas, probes);
+  const Block<double> p = chart_points(atlas, probes, shape);
   out.uv.resize(V + 3 * n, 2);
   out.uv.topRows(V) = vertex_uv;
   for (Index k = 0; k < n; ++k) {

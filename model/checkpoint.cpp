@@ -32,15 +32,20 @@ void put_string(std::string& out, const std::string& s) {
 
 }  // namespace
 
-void write_checkpoint(const std::string& path, const std::string& input, const FitOptions& options,
-                      const Normalization& normalization, const Trainer& trainer) {
+void write_checkpoint(const std::string& path, const std::vector<std::string>& inputs,
+                      const FitOptions& options, const std::vector<Normalization>& normalizations,
+                      const Trainer& trainer) {
+  JSA_CHECK(inputs.size() == normalizations.size() && !inputs.empty(), "one normalisation per input");
   std::string body(kMagic, sizeof kMagic);
   body.append(reinterpret_cast<const char*>(&kVersion), sizeof kVersion);
-  put_string(body, input);
+  const uint64_t count = inputs.size();
+  body.append(reinterpret_cast<const char*>(&count), sizeof count);
+  for (const std::string& input : inputs) put_string(body, input);
   put_string(body, fit_options_to_json(options, -1));
-  double norm[4] = {normalization.center(0), normalization.center(1), normalization.center(2),
-                    normalization.scale};
-  body.append(reinterpret_cast<const char*>(norm), sizeof norm);
+  for (const Normalization& n : normalizations) {
+    const double norm[4] = {n.center(0), n.center(1), n.center(2), n.scale};
+    body.append(reinterpret_cast<const char*>(norm), sizeof norm);
+  }
   std::ostringstream state;
   trainer.save_state(state);
   put_string(body, state.str());
@@ -81,12 +86,20 @@ CheckpointContents read_checkpoint(const std::string& path) {
     throw InputError(path + ": checkpoint format " + std::to_string(version) + ", this build reads " +
                      std::to_string(kVersion));
   CheckpointContents c;
-  c.input = take_string();
+  uint64_t count = 0;
+  take(&count, sizeof count);
+  if (count == 0 || count > 100000) throw InputError(path + ": implausible shape count in checkpoint");
+  for (uint64_t i = 0; i < count; ++i) c.inputs.push_back(take_string());
   c.settings_json = take_string();
-  double norm[4];
-  take(norm, sizeof norm);
-  c.normalization.center = Eigen::RowVector3d(norm[0], norm[1], norm[2]);
-  c.normalization.scale = norm[3];
+  for (uint64_t i = 0; i < count; ++i) {
+    double norm[4];
+    take(norm, sizeof norm);
+    Normalization n;
+    n.center = Eigen::RowVector3d(norm[0], norm[1], norm[2]);
+    n.scale = norm[3];
+    if (!(n.scale > 0) || !n.center.allFinite()) throw InputError(path + ": bad normalisation in checkpoint");
+    c.normalizations.push_back(n);
+  }
   c.state = take_string();
   if (at != end) throw InputError(path + ": trailing bytes in checkpoint");
   return c;

@@ -118,7 +118,7 @@ DomainMesh mesh_domain(const Atlas<float>& atlas, const DomainMeshOptions& o) {
 }
 
 void evaluate_surface(Atlas<float>& atlas, const Block<double>& uv, Block<double>& points,
-                      Block<double>& normals) {
+                      Block<double>& normals, int shape) {
   points.resize(uv.rows(), 3);
   normals.resize(uv.rows(), 3);
   Tape<float> t;
@@ -127,7 +127,7 @@ void evaluate_surface(Atlas<float>& atlas, const Block<double>& uv, Block<double
     const Index n = std::min(batch, uv.rows() - b);
     t.clear();
     Var x = t.constant(uv.middleRows(b, n).cast<float>());
-    SurfacePoints s = atlas.phi.evaluate(t, atlas.params, x, true);
+    SurfacePoints s = atlas.phi.evaluate(t, atlas.params, x, true, atlas.phi_code(t, shape));
     points.middleRows(b, n) = t.value(s.points).cast<double>();
     normals.middleRows(b, n) = t.value(s.normals).cast<double>().rowwise().normalized();
   }

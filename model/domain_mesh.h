@@ -33,8 +33,9 @@ struct DomainMesh {
 
 DomainMesh mesh_domain(const Atlas<float>& atlas, const DomainMeshOptions& options);
 
-// phi at the rows of uv (V x 2), in batches: points (V x 3) and unit normals (V x 3).
+// phi of shape `shape` at the rows of uv (V x 2), in batches: points (V x 3,
+// unit frame) and unit normals (V x 3).
 void evaluate_surface(Atlas<float>& atlas, const Block<double>& uv, Block<double>& points,
-                      Block<double>& normals);
+                      Block<double>& normals, int shape = 0);
 
 }  // namespace jsa

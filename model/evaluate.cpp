@@ -6,18 +6,19 @@
 namespace jsa {
 
 void sample_reconstruction(Atlas<float>& atlas, Index count, Rng& rng, Block<double>& uv,
-                           Block<double>& points, Block<double>& normals) {
+                           Block<double>& points, Block<double>& normals, int shape) {
   Tape<float> t;
   Var x = atlas.domain.sample(t, atlas.params, count, rng);
   uv = t.value(x).cast<double>();
-  evaluate_surface(atlas, uv, points, normals);
+  evaluate_surface(atlas, uv, points, normals, shape);
 }
 
 Evaluation evaluate_reconstruction(Atlas<float>& atlas, const Mesh& shape,
-                                   const Normalization& normalization, const EvaluationOptions& o) {
+                                   const Normalization& normalization, const EvaluationOptions& o,
+                                   int index) {
   Rng rng_p(o.seed, 10), rng_a(o.seed, 11), rng_b(o.seed, 12);
   Block<double> uv, pp, pn;
-  sample_reconstruction(atlas, o.samples, rng_p, uv, pp, pn);
+  sample_reconstruction(atlas, o.samples, rng_p, uv, pp, pn, index);
   SurfaceSamples a = sample_surface(shape, o.samples, rng_a);
   SurfaceSamples b = sample_surface(shape, o.samples, rng_b);
   const Block<double> ap = normalization.to_unit(a.points), bp = normalization.to_unit(b.points);

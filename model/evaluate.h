@@ -22,9 +22,11 @@ struct Evaluation {
 
 // `count` points of the reconstruction: uv ~ P, points = phi(uv), unit normals.
 void sample_reconstruction(Atlas<float>& atlas, Index count, Rng& rng, Block<double>& uv,
-                           Block<double>& points, Block<double>& normals);
+                           Block<double>& points, Block<double>& normals, int shape = 0);
 
+// `index`: which shape of a collection (0 for a single shape).
 Evaluation evaluate_reconstruction(Atlas<float>& atlas, const Mesh& shape,
-                                   const Normalization& normalization, const EvaluationOptions& o);
+                                   const Normalization& normalization, const EvaluationOptions& o,
+                                   int index = 0);
 
 }  // namespace jsa

@@ -11,12 +11,15 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["atlas"] = {{"gaussians", o.atlas.gaussians},
                 {"width", o.atlas.width},
                 {"hidden_layers", o.atlas.hidden_layers},
-                {"alpha", o.atlas.alpha}};
+                {"alpha", o.atlas.alpha},
+                {"shapes", o.atlas.shapes},
+                {"code_size", o.atlas.code_size}};
   j["weights"] = {{"surface_6d", o.weights.surface},
                   {"chart_2d", o.weights.chart},
                   {"cycle", o.weights.cycle},
                   {"isometry", o.weights.isometry},
                   {"repulsion", o.weights.repulsion},
+                  {"code", o.weights.code},
                   {"convention", "mean over points (paper's 1/M factors folded in)"}};
   j["components"] = {{"normals", o.components.normals},
                      {"repulsion", o.components.repulsion},
@@ -56,12 +59,15 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   field(a, "atlas.", "width", o.atlas.width);
   field(a, "atlas.", "hidden_layers", o.atlas.hidden_layers);
   field(a, "atlas.", "alpha", o.atlas.alpha);
+  field(a, "atlas.", "shapes", o.atlas.shapes);
+  field(a, "atlas.", "code_size", o.atlas.code_size);
   const json& w = j.contains("weights") ? j["weights"] : json();
   field(w, "weights.", "surface_6d", o.weights.surface);
   field(w, "weights.", "chart_2d", o.weights.chart);
   field(w, "weights.", "cycle", o.weights.cycle);
   field(w, "weights.", "isometry", o.weights.isometry);
   field(w, "weights.", "repulsion", o.weights.repulsion);
+  field(w, "weights.", "code", o.weights.code);
   const json& c = j.contains("components") ? j["components"] : json();
   field(c, "components.", "normals", o.components.normals);
   field(c, "components.", "repulsion", o.components.repulsion);
@@ -75,7 +81,8 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   field(j, "", "decay", o.decay);
   field(j, "", "seed", o.seed);
   field(j, "", "repulsion_tolerance", o.repulsion_tolerance);
-  if (o.atlas.gaussians <= 0 || o.atlas.width <= 0 || o.atlas.hidden_layers < 0 || o.points <= 0)
+  if (o.atlas.gaussians <= 0 || o.atlas.width <= 0 || o.atlas.hidden_layers < 0 || o.points <= 0 ||
+      o.atlas.shapes <= 0 || o.atlas.code_size <= 0)
     throw InputError(what + ": sizes must be positive");
   return o;
 }

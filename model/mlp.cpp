@@ -16,6 +16,10 @@ Mlp<T>::Mlp(Parameters<T>& params, const std::string& name, const MlpShape& shap
     bias_.push_back(params.add(name + ".b" + std::to_string(k), 1, out));
     in = out;
   }
+  if (shape.code_size > 0) {
+    const int first_out = shape.hidden_layers > 0 ? shape.width : shape.out;
+    code_weight_ = params.add(name + ".wf", shape.code_size, first_out);
+  }
 }
 
 template <class T>
@@ -27,16 +31,26 @@ void Mlp<T>::initialize(Parameters<T>& params, Rng& rng) const {
     for (Index i = 0; i < w.size(); ++i) w.data()[i] = T(rng.uniform(-bound, bound));
     for (Index i = 0; i < b.size(); ++i) b.data()[i] = T(rng.uniform(-bound, bound));
   }
+  if (code_weight_ >= 0) {
+    // As if W_f were the code's rows of one (in + D) x width first layer.
+    auto w = params.value(code_weight_);
+    const double bound = 1.0 / std::sqrt(double(shape_.in + shape_.code_size));
+    for (Index i = 0; i < w.size(); ++i) w.data()[i] = T(rng.uniform(-bound, bound));
+  }
 }
 
 template <class T>
-Var Mlp<T>::forward(Tape<T>& t, Parameters<T>& params, Var x, Index value_rows) const {
+Var Mlp<T>::forward(Tape<T>& t, Parameters<T>& params, Var x, Index value_rows, Var code) const {
   const Index rows = t.rows(x);
   if (value_rows < 0) value_rows = rows;
   JSA_CHECK(t.cols(x) == shape_.in, "MLP expects " << shape_.in << " input columns, got " << t.cols(x));
+  JSA_CHECK(code.valid() == (code_weight_ >= 0), "a latent code is needed iff the MLP has code_size > 0");
   Var h = x;
   for (size_t k = 0; k < weight_.size(); ++k) {
-    h = linear(t, h, params.on(t, weight_[k]), params.on(t, bias_[k]), value_rows);
+    Var bias = params.on(t, bias_[k]);
+    // [x, f] W = x W_x + f W_f: the code enters as part of the first bias.
+    if (k == 0 && code.valid()) bias = add(t, bias, linear(t, code, params.on(t, code_weight_), Var{}));
+    h = linear(t, h, params.on(t, weight_[k]), bias, value_rows);
     if (k + 1 < weight_.size()) h = relu_masked(t, h, value_rows);
   }
   return h;

@@ -6,6 +6,13 @@
 // see engine/tangents.h): with value_rows = N the bias goes to the first N rows
 // only and every ReLU takes its mask from them, so each layer is one GEMM that
 // carries the value and both Jacobian columns at once.
+//
+// Latent codes (collections, Sec. 3.4): an MLP built with code_size = D > 0
+// takes a 1 x D code f with every call. Concatenating f to each input row,
+// [x, f] W = x W_x + f W_f, is the same as adding the row f W_f to the first
+// layer's bias, so that is how it is computed: one 1 x D by D x width product
+// per call instead of D extra columns in the first GEMM. As a bias, it touches
+// only the value rows: the code does not change with (u, v).
 #pragma once
 #include <string>
 #include <vector>
@@ -21,6 +28,7 @@ struct MlpShape {
   int out = 3;            // output features
   int width = 256;        // units per hidden layer
   int hidden_layers = 5;  // ReLU layers before the linear output layer
+  int code_size = 0;      // D: latent code width (0: no code)
 };
 
 template <class T>
@@ -31,8 +39,9 @@ class Mlp {
   Mlp(Parameters<T>& params, const std::string& name, const MlpShape& shape);
   // PyTorch's nn.Linear default, as the authors' code used: W, b ~ U(-1/sqrt(in), 1/sqrt(in)).
   void initialize(Parameters<T>& params, Rng& rng) const;
-  // y = f(x). value_rows < 0: plain rows. value_rows = N: x is [value; tangents...].
-  Var forward(Tape<T>& t, Parameters<T>& params, Var x, Index value_rows = -1) const;
+  // y = f(x) or f([x, code]). value_rows < 0: plain rows. value_rows = N: x is
+  // [value; tangents...]. code: 1 x code_size (required iff code_size > 0).
+  Var forward(Tape<T>& t, Parameters<T>& params, Var x, Index value_rows = -1, Var code = {}) const;
   const MlpShape& shape() const { return shape_; }
   // Multiply-adds of one forward pass over `rows` rows (for GFLOP/s reports).
   double flops(Index rows) const;
@@ -40,6 +49,7 @@ class Mlp {
  private:
   MlpShape shape_;
   std::vector<int> weight_, bias_;  // parameter indices per layer
+  int code_weight_ = -1;            // W_f (code_size x width)
 };
 
 }  // namespace jsa

@@ -22,9 +22,10 @@ Components Components::table_row(int row) {
 }
 
 template <class T>
-Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, const Block<T>& targets, Index m, Rng& rng,
-                           const LossWeights& w, const Components& c, LossTerms* terms,
-                           double repulsion_tolerance) {
+Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T>& targets, Index m,
+                           Rng& rng, const ObjectiveOptions& o, LossTerms* terms) {
+  const LossWeights& w = o.weights;
+  const Components& c = o.components;
   JSA_CHECK(targets.cols() == 6, "targets must be M x 6 [x_S, alpha n_S]");
   Parameters<T>& p = atlas.params;
   LossTerms out;
@@ -33,14 +34,15 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, const Block<T>& targets,
   // {x_P} ~ P by the reparameterization trick (Eq. 4).
   const Var x_p = atlas.domain.sample(t, p, m, rng);  // M x 2
   const Var s6 = t.constant(targets);
+  const Var f_phi = atlas.phi_code(t, shape), f_psi = atlas.psi_code(t, shape);
   const bool jacobian = c.normals || c.isometry || c.chart;
 
   // psi({x_S, n_S}) first: the 6D cycle evaluates phi at these 2D points, and
   // batching them with x_P makes phi one pass over 2M points.
   Var u_s;
-  if (c.chart) u_s = atlas.psi.evaluate(t, p, s6);
+  if (c.chart) u_s = atlas.psi.evaluate(t, p, s6, f_psi);
   const Var phi_in = c.chart ? concat_rows(t, {x_p, u_s}) : x_p;
-  SurfacePoints all = atlas.phi.evaluate(t, p, phi_in, jacobian);
+  SurfacePoints all = atlas.phi.evaluate(t, p, phi_in, jacobian, f_phi);
   // Diverged networks: report NaN (the trainer recovers) rather than search
   // nearest neighbours among non-finite points.
   if (!t.value(phi_in).allFinite() || !t.value(all.points).allFinite() ||
@@ -64,7 +66,7 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, const Block<T>& targets,
     weighted.push_back({w.chart, chart});
     out.chart = double(t.scalar(chart));
     // L_cycle (Eq. 9): 2D -> 6D -> 2D on {x_P}, and 6D -> 2D -> 6D on {x_S, n_S}.
-    const Var back_2d = atlas.psi.evaluate(t, p, first_m(all.phi6));
+    const Var back_2d = atlas.psi.evaluate(t, p, first_m(all.phi6), f_psi);
     const Var cycle_2d = mean_squared_distance(t, x_p, back_2d);
     const Var cycle_6d = mean_squared_distance(t, s6, last_m(all.phi6));
     weighted.push_back({w.cycle, cycle_2d});
@@ -81,7 +83,7 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, const Block<T>& targets,
   if (c.repulsion) {
     // L_rep on the means   (Eq. 11)
     const Var rep = repulsion(t, p.on(t, atlas.domain.means()), atlas.domain.sigma(),
-                              RepulsionOptions{repulsion_tolerance});
+                              RepulsionOptions{o.repulsion_tolerance});
     weighted.push_back({w.repulsion, rep});
     out.repulsion = double(t.scalar(rep));
   }
@@ -95,11 +97,48 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, const Block<T>& targets,
   return total;
 }
 
-template Var single_shape_objective<float>(Tape<float>&, Atlas<float>&, const Block<float>&, Index,
-                                           Rng&, const LossWeights&, const Components&, LossTerms*,
-                                           double);
-template Var single_shape_objective<double>(Tape<double>&, Atlas<double>&, const Block<double>&,
-                                            Index, Rng&, const LossWeights&, const Components&,
-                                            LossTerms*, double);
+template <class T>
+Var collection_objective(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>>& targets, Index m,
+                         Rng& rng, const ObjectiveOptions& o, LossTerms* terms) {
+  const int n = int(targets.size());
+  JSA_CHECK(n == atlas.shapes(), targets.size() << " target sets for " << atlas.shapes() << " shapes");
+  ObjectiveOptions per_shape = o;
+  per_shape.components.repulsion = false;
+  LossTerms sum_terms, one;
+  Var total;
+  for (int i = 0; i < n; ++i) {
+    const Var l = single_shape_objective(t, atlas, i, targets[size_t(i)], m, rng, per_shape, &one);
+    total = i == 0 ? l : add(t, total, l);
+    sum_terms.surface += one.surface / n;
+    sum_terms.chart += one.chart / n;
+    sum_terms.cycle_2d += one.cycle_2d / n;
+    sum_terms.cycle_6d += one.cycle_6d / n;
+    sum_terms.isometry += one.isometry / n;
+  }
+  if (o.components.repulsion) {
+    const Var rep = repulsion(t, atlas.params.on(t, atlas.domain.means()), atlas.domain.sigma(),
+                              RepulsionOptions{o.repulsion_tolerance});
+    sum_terms.repulsion = double(t.scalar(rep));
+    total = add(t, total, scale(t, rep, T(n * o.weights.repulsion)));
+  }
+  if (atlas.has_codes() && o.weights.code > 0) {
+    // (1/N) sum_i (|f_phi,i|^2 + |f_psi,i|^2)
+    Var norms = sum(t, square(t, atlas.phi_code(t, 0)));
+    for (int i = 1; i < n; ++i) norms = add(t, norms, sum(t, square(t, atlas.phi_code(t, i))));
+    for (int i = 0; i < n; ++i) norms = add(t, norms, sum(t, square(t, atlas.psi_code(t, i))));
+    total = add(t, total, scale(t, norms, T(o.weights.code / n)));
+  }
+  sum_terms.total = double(t.scalar(total));
+  if (terms) *terms = sum_terms;
+  return total;
+}
+
+#define JSA_INSTANTIATE(T)                                                                        \
+  template Var single_shape_objective<T>(Tape<T>&, Atlas<T>&, int, const Block<T>&, Index, Rng&, \
+                                         const ObjectiveOptions&, LossTerms*);                   \
+  template Var collection_objective<T>(Tape<T>&, Atlas<T>&, const std::vector<Block<T>>&, Index, \
+                                       Rng&, const ObjectiveOptions&, LossTerms*);
+JSA_INSTANTIATE(float)
+JSA_INSTANTIATE(double)
 
 }  // namespace jsa

@@ -18,6 +18,7 @@ struct LossWeights {
   double cycle = 1.0;       // l_cycle, on L_cycle (Eq. 9), mean convention
   double isometry = 1e-4;   // l_iso, on L_iso (Eq. 10), mean convention
   double repulsion = 1.0;   // l_rep, on L_rep (Eq. 11)
+  double code = 1e-4;       // collections: weight of the mean squared norm of the latent codes
 };
 
 // Which parts of the method are on. The default is Table 1 row 11, the full method.
@@ -37,11 +38,25 @@ struct LossTerms {
          repulsion = 0;
 };
 
-// Builds L_single on the tape and returns it (1 x 1). targets: M x 6 rows
-// [x_S, alpha n_S] sampled on the shape; `samples` 2D points are drawn from P.
+struct ObjectiveOptions {
+  LossWeights weights;
+  Components components;
+  double repulsion_tolerance = 1e-7;  // bound on the error of L_rep from its cut-off
+};
+
+// Builds L_single of shape `shape` (0 for a single shape) on the tape and returns
+// it (1 x 1). targets: rows [x_S, alpha n_S] sampled on the shape; `samples` 2D
+// points are drawn from P.
 template <class T>
-Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, const Block<T>& targets, Index samples,
-                           Rng& rng, const LossWeights& w, const Components& c, LossTerms* terms,
-                           double repulsion_tolerance = 1e-7);
+Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T>& targets,
+                           Index samples, Rng& rng, const ObjectiveOptions& o, LossTerms* terms);
+
+// L_full, Eq. (12): sum over the shapes of L_single. L_rep depends on mu alone,
+// so it is computed once and counted N times (as the sum does); a collection
+// adds l_code * mean |f|^2 over its codes (the auto-decoder's prior). terms
+// receives the per-shape terms averaged over the shapes.
+template <class T>
+Var collection_objective(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>>& targets,
+                         Index samples, Rng& rng, const ObjectiveOptions& o, LossTerms* terms);
 
 }  // namespace jsa

@@ -7,15 +7,15 @@ namespace jsa {
 
 template <class T>
 SurfacePoints Parametrization<T>::evaluate(Tape<T>& t, Parameters<T>& params, Var x,
-                                           bool with_jacobian) const {
+                                           bool with_jacobian, Var code) const {
   SurfacePoints s;
   if (!with_jacobian) {
-    s.points = mlp_.forward(t, params, x);
+    s.points = mlp_.forward(t, params, x, -1, code);
     return s;
   }
   // [x; e_u; e_v] -> [phi(x); J_u; J_v]: one pass, 3M rows (Eq. 1).
   const Index m = t.rows(x);
-  Stacked y = unstack(t, mlp_.forward(t, params, stack_tangents(t, x), m));
+  Stacked y = unstack(t, mlp_.forward(t, params, stack_tangents(t, x), m, code));
   s.points = y.value;
   s.du = y.du;
   s.dv = y.dv;

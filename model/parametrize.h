@@ -20,12 +20,14 @@ template <class T>
 class Parametrization {
  public:
   Parametrization() = default;
-  // in = 2 (+ latent code width for collections), out = 3.
+  // in = 2, out = 3 (code_size: the latent code width in a collection).
   Parametrization(Parameters<T>& params, const MlpShape& shape, T alpha)
       : mlp_(params, "phi", shape), alpha_(alpha) {}
   void initialize(Parameters<T>& params, Rng& rng) const { mlp_.initialize(params, rng); }
-  // x: M x in (u, v first). with_jacobian = false evaluates phi(x) alone.
-  SurfacePoints evaluate(Tape<T>& t, Parameters<T>& params, Var x, bool with_jacobian) const;
+  // x: M x 2 domain points. with_jacobian = false evaluates phi(x) alone.
+  // code: the shape's latent code f_phi,i (1 x D) in a collection, else none.
+  SurfacePoints evaluate(Tape<T>& t, Parameters<T>& params, Var x, bool with_jacobian,
+                         Var code = {}) const;
   const Mlp<T>& mlp() const { return mlp_; }
   T alpha() const { return alpha_; }
 

@@ -8,18 +8,23 @@
 
 namespace jsa {
 
-Trainer::Trainer(const FitOptions& o, const Block<double>& pool) : options_(o), rng_(o.seed, 0) {
-  JSA_CHECK(pool.cols() == 6 && pool.rows() > 0, "the target pool must be P x 6");
+Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools)
+    : options_(o), rng_(o.seed, 0) {
+  JSA_CHECK(!pools.empty(), "no shapes to fit");
   if (o.points <= 0) throw InputError("--points must be positive");
   if (o.iterations < 0) throw InputError("--iters must be >= 0");
-  pool_ = pool.cast<float>();
-  pool_.rightCols(3) *= float(o.atlas.alpha);
-  AtlasOptions ao = o.atlas;
+  for (const Block<double>& pool : pools) {
+    JSA_CHECK(pool.cols() == 6 && pool.rows() > 0, "a target pool must be P x 6");
+    pools_.push_back(pool.cast<float>());
+    pools_.back().rightCols(3) *= float(o.atlas.alpha);
+    targets_.emplace_back(o.points, 6);
+  }
+  options_.atlas.shapes = int(pools.size());
+  AtlasOptions ao = options_.atlas;
   ao.gaussian_noise = o.components.distribution;
   atlas_ = std::make_unique<Atlas<float>>(ao);
   Rng init(o.seed, 1);
   atlas_->initialize(init);
-  targets_.resize(o.points, 6);
 }
 
 double Trainer::learning_rate() const {
@@ -36,12 +41,13 @@ void Trainer::take_snapshot() {
 }
 
 void Trainer::step() {
-  // M targets {x_S, n_S}, drawn with replacement from the pool.
-  for (Index m = 0; m < options_.points; ++m)
-    targets_.row(m) = pool_.row(Index(rng_.below(uint64_t(pool_.rows()))));
+  // M targets {x_S, n_S} per shape, drawn with replacement from its pool.
+  for (size_t i = 0; i < pools_.size(); ++i)
+    for (Index m = 0; m < options_.points; ++m)
+      targets_[i].row(m) = pools_[i].row(Index(rng_.below(uint64_t(pools_[i].rows()))));
   tape_.clear();
-  Var loss = single_shape_objective(tape_, *atlas_, targets_, options_.points, rng_, options_.weights,
-                                    options_.components, &last_, options_.repulsion_tolerance);
+  const ObjectiveOptions objective{options_.weights, options_.components, options_.repulsion_tolerance};
+  Var loss = collection_objective(tape_, *atlas_, targets_, options_.points, rng_, objective, &last_);
   atlas_->params.zero_grad();
   tape_.backward(loss);
   if (iteration_ == fault_at_ && faults_to_inject_ > 0) {

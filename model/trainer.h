@@ -43,9 +43,12 @@ struct NumericalFault : std::runtime_error {
 
 class Trainer {
  public:
-  // pool: P x 6 rows [x_S, n_S] in the unit frame, n_S unit length; scaled by
-  // alpha here. The pool is drawn once; each step takes M of its rows.
-  Trainer(const FitOptions& options, const Block<double>& pool);
+  // pools: per shape, P x 6 rows [x_S, n_S] in the shape's unit frame, n_S unit
+  // length (scaled by alpha here). Drawn once; each step takes M rows of each.
+  // More than one pool makes a collection: options.atlas.shapes is set to their count.
+  Trainer(const FitOptions& options, const std::vector<Block<double>>& pools);
+  Trainer(const FitOptions& options, const Block<double>& pool)
+      : Trainer(options, std::vector<Block<double>>{pool}) {}
   // One iteration. A NaN or Inf in the loss or the gradient is caught before
   // Adam sees it: the last good state is restored, the learning rate halved,
   // and the batch skipped; after max_faults such steps in a row, NumericalFault.
@@ -69,14 +72,14 @@ class Trainer {
 
  private:
   FitOptions options_;
-  Block<float> pool_;  // P x 6, normals scaled by alpha
+  std::vector<Block<float>> pools_;  // per shape P x 6, normals scaled by alpha
   std::unique_ptr<Atlas<float>> atlas_;
   Adam<float> adam_;
   Tape<float> tape_;
   Rng rng_;
   int64_t iteration_ = 0;
   LossTerms last_;
-  Block<float> targets_;
+  std::vector<Block<float>> targets_;
   // The last good state, refreshed every kSnapshotEvery iterations.
   static constexpr int64_t kSnapshotEvery = 50;
   std::vector<float> good_params_, good_m_, good_v_;

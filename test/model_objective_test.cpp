@@ -23,11 +23,13 @@ Block<double> random_targets(Index n, double alpha, uint64_t seed) {
   return t;
 }
 
-double objective_value(Atlas<double>& atlas, const Block<double>& targets, const Components& c,
+double objective_value(Atlas<double>& atlas, const std::vector<Block<double>>& targets, const Components& c,
                        Tape<double>& tape, bool backward) {
   Rng rng(99);  // the same draws every evaluation: the objective is a fixed function
   tape.clear();
-  Var loss = single_shape_objective(tape, atlas, targets, 24, rng, LossWeights{}, c, nullptr);
+  ObjectiveOptions o;
+  o.components = c;
+  Var loss = collection_objective(tape, atlas, targets, 24, rng, o, nullptr);
   if (backward) {
     atlas.params.zero_grad();
     tape.backward(loss);
@@ -49,7 +51,7 @@ TEST_CASE("objective: gradients of L_single match central differences", "[object
     Rng init(5);
     atlas.initialize(init);
     // Large weights for the small terms so that they matter in the check.
-    const Block<double> targets = random_targets(32, ao.alpha, 3);
+    const std::vector<Block<double>> targets{random_targets(32, ao.alpha, 3)};
     Tape<double> tape;
     objective_value(atlas, targets, c, tape, true);
     const std::vector<double> analytic = atlas.params.grads();
@@ -75,6 +77,49 @@ TEST_CASE("objective: gradients of L_single match central differences", "[object
     CHECK(checked > 30);
     CHECK(worst <= 1.0);
   }
+}
+
+TEST_CASE("objective: gradients of L_full for a collection (latent codes) match central differences", "[objective]") {
+  AtlasOptions ao;
+  ao.gaussians = 16;
+  ao.width = 8;
+  ao.hidden_layers = 2;
+  ao.shapes = 2;
+  ao.code_size = 4;
+  Atlas<double> atlas(ao);
+  Rng init(5);
+  atlas.initialize(init);
+  // Codes larger than their N(0, 0.01^2) start, so that they matter in the check.
+  for (const char* name : {"codes.phi", "codes.psi"}) {
+    auto c = atlas.params.value(atlas.params.find(name));
+    for (Index i = 0; i < c.size(); ++i) c.data()[i] = 0.3 * std::sin(1.0 + 3.0 * double(i));
+  }
+  const std::vector<Block<double>> targets{random_targets(32, ao.alpha, 3), random_targets(32, ao.alpha, 4)};
+  const Components c;
+  Tape<double> tape;
+  objective_value(atlas, targets, c, tape, true);
+  const std::vector<double> analytic = atlas.params.grads();
+  double worst = 0;
+  int checked = 0;
+  for (const char* name : {"codes.phi", "codes.psi", "phi.wf", "psi.wf", "domain.mu", "phi.w0"}) {
+    const auto& e = atlas.params.entry(atlas.params.find(name));
+    for (size_t i = e.offset; i < e.offset + size_t(e.rows * e.cols); i += 3) {
+      double& x = atlas.params.values()[i];
+      const double x0 = x, h = 1e-6 * std::max(1.0, std::abs(x0));
+      x = x0 + h;
+      const double lp = objective_value(atlas, targets, c, tape, false);
+      x = x0 - h;
+      const double lm = objective_value(atlas, targets, c, tape, false);
+      x = x0;
+      const double num = (lp - lm) / (2 * h);
+      worst = std::max(worst, std::abs(num - analytic[i]) /
+                                  (1e-7 + 1e-4 * std::max(std::abs(num), std::abs(analytic[i]))));
+      ++checked;
+    }
+  }
+  INFO(checked << " entries, worst error/tolerance " << worst);
+  CHECK(checked > 40);
+  CHECK(worst <= 1.0);
 }
 
 TEST_CASE("objective: ablation rows switch the terms on one by one", "[objective]") {
