@@ -15,5 +15,7 @@ void add_fit(CLI::App& app);
 void add_eval(CLI::App& app);
 void add_mesh(CLI::App& app);
 void add_chart(CLI::App& app);
+void add_correspond(CLI::App& app);
+void add_eval_corr(CLI::App& app);
 
 }  // namespace jsa::cli

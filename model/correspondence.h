@@ -1,0 +1,43 @@
+// Correspondences through a joint atlas (paper Sec. 4, "Correspondence metric"):
+// a point p on shape I goes to q = phi_J(psi_I(p)) on shape J. Runs without a
+// chart (ablation rows 6-9) use the paper's nearest-sample rule instead: sample
+// P, map the samples to shape I by phi_I, take the one whose image is nearest
+// to p, and map that 2D point by phi_J.
+#pragma once
+#include <vector>
+
+#include "io/mesh.h"
+#include "io/normalization.h"
+#include "model/atlas.h"
+
+namespace jsa {
+
+struct CorrespondenceOptions {
+  bool use_chart = true;        // false: the nearest-sample rule (no psi)
+  Index nearest_samples = 20000;  // samples of P for the nearest-sample rule
+  uint64_t seed = 0;
+};
+
+// p_unit: N x 3 points and n: N x 3 unit normals on shape `from`, in its unit
+// frame. Returns N x 3 points on shape `to`, in its unit frame.
+Block<double> correspond(Atlas<float>& atlas, int from, int to, const Block<double>& p_unit,
+                         const Block<double>& normals, const CorrespondenceOptions& o);
+
+// Vertex normals of a mesh: from the file, or area-weighted from the faces.
+Block<double> vertex_normals_of(const Mesh& mesh);
+
+struct KeypointError {
+  double mean = 0;                // mean |q - q_gt| over all ordered pairs, unit frame of the target
+  std::vector<double> within;     // fraction of keypoints within each threshold
+  std::vector<double> thresholds;
+  Index pairs = 0, keypoints = 0;
+  std::vector<std::vector<double>> pair_mean;  // [I][J] mean error (0 on the diagonal)
+};
+
+// meshes/frames/keypoints per shape of the collection, keypoints[i][k] a vertex of meshes[i].
+KeypointError keypoint_error(Atlas<float>& atlas, const std::vector<Mesh>& meshes,
+                             const std::vector<Normalization>& frames,
+                             const std::vector<std::vector<int>>& keypoints, const CorrespondenceOptions& o,
+                             const std::vector<double>& thresholds = {0.01, 0.02, 0.05, 0.1});
+
+}  // namespace jsa
