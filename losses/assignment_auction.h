@@ -29,7 +29,7 @@ struct IntegerAssignment {
 // caller's units. A matching within n * epsilon of optimal is then optimal,
 // because two matchings of integer cost differ by at least 1.
 // Throws InternalError if the scaled costs could overflow 64 bits
-// (needs max|c| (n + 1)^2 below about 2^61). Serial and deterministic.
+// (needs (max c - min c) (n + 1)^2 below 2^61). Serial and deterministic.
 IntegerAssignment assign_auction(const Block<int64_t>& cost, const AuctionOptions& options = {});
 
 // round(scale * cost) entry by entry (finite costs, |scale * cost| < 2^53).
