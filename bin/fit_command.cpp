@@ -3,6 +3,7 @@
 // --checkpoint-every iterations and at the end) and DIR/domain_mesh.obj.
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -28,13 +29,12 @@ struct FitArgs {
   std::vector<std::string> inputs;
   std::string list_file, out_dir, resume;
   FitOptions options;
-  int threads = 0;
+  int threads = -1;  // -1: not given (a resumed run keeps its own)
   int checkpoint_every = 500;
   int table_row = 0;
   bool no_normals = false, no_repulsion = false, no_distribution = false, no_chart = false,
        no_isometry = false;
   std::string preset;
-  Index pool = 200000;
   int mesh_resolution = 256;
   double mesh_threshold = 0.3;
   bool quiet = false;
@@ -86,14 +86,15 @@ void run_fit(FitArgs& a) {
     if (a.no_chart) o.components.chart = false;
     if (a.no_isometry) o.components.isometry = false;
   }
-  set_threads(a.threads);
+  if (a.threads >= 0) o.threads = a.threads;
+  set_threads(o.threads);
 
   // Each shape, a fixed pool of surface samples, and its unit frame (Sec. 4 data).
   std::vector<RunInput> shapes;
   std::vector<Block<double>> pools;
   std::vector<Normalization> frames;
   for (size_t i = 0; i < inputs.size(); ++i) {
-    shapes.push_back(load_run_input(inputs[i], a.pool, o.seed + 1000 * i));
+    shapes.push_back(load_run_input(inputs[i], o.pool, o.seed + 1000 * i));
     if (resuming) shapes.back().normalization = resumed.normalizations[i];
     pools.push_back(shapes.back().pool);
     frames.push_back(shapes.back().normalization);
@@ -172,6 +173,17 @@ void run_fit(FitArgs& a) {
 
 }  // namespace
 
+// CLI11's number checks let NaN through (every comparison with NaN is false).
+const CLI::Validator kFinite(
+    [](std::string& s) {
+      try {
+        return std::isfinite(std::stod(s)) ? std::string() : "must be a finite number, got " + s;
+      } catch (const std::exception&) {
+        return "must be a number, got " + s;
+      }
+    },
+    "FINITE");
+
 void add_fit(CLI::App& app) {
   auto a = std::make_shared<FitArgs>();
   FitOptions& o = a->options;
@@ -179,7 +191,7 @@ void add_fit(CLI::App& app) {
   c->add_option("inputs", a->inputs, "Mesh (.obj .off .ply), oriented point cloud (.ply with normals, .xyz x y z nx ny nz), or builtin:NAME (sphere, torus, cube, capsule); several inputs fit a collection with one shared domain (Sec. 3.4)");
   c->add_option("--list", a->list_file, "A file naming one input per line (collections)");
   c->add_option("--code-size", o.atlas.code_size, "Collections: width of the latent codes f_phi,i and f_psi,i")->capture_default_str()->check(CLI::Range(1, 4096));
-  c->add_option("--w-code", o.weights.code, "Collections: weight of the mean squared norm of the codes")->capture_default_str()->check(CLI::NonNegativeNumber);
+  c->add_option("--w-code", o.weights.code, "Collections: weight of the mean squared norm of the codes")->capture_default_str()->check(CLI::NonNegativeNumber)->check(kFinite);
   c->add_option("-o,--out", a->out_dir, "Output directory (created if needed)");
   c->add_option("--resume", a->resume, "Continue the run in DIR from its model.ckpt (settings come from the checkpoint)");
   c->add_option("--iters", o.iterations, "Training iterations")->capture_default_str()->check(CLI::Range(int64_t(0), int64_t(100000000)));
@@ -187,17 +199,17 @@ void add_fit(CLI::App& app) {
   c->add_option("--gaussians,-K", o.atlas.gaussians, "K: Gaussians in the domain P (sigma = 1/sqrt(K))")->capture_default_str()->check(CLI::Range(1, 1000000));
   c->add_option("--width", o.atlas.width, "Hidden units of phi and psi")->capture_default_str()->check(CLI::Range(4, 4096));
   c->add_option("--depth", o.atlas.hidden_layers, "Hidden layers of phi and psi")->capture_default_str()->check(CLI::Range(1, 32));
-  c->add_option("--alpha", o.atlas.alpha, "Norm of the scaled normals (Eq. 2)")->capture_default_str()->check(CLI::PositiveNumber);
-  c->add_option("--lr", o.lr, "Adam learning rate")->capture_default_str()->check(CLI::PositiveNumber);
-  c->add_option("--decay", o.decay, "Learning-rate factor at each decay point")->capture_default_str()->check(CLI::Range(0.0, 1.0));
+  c->add_option("--alpha", o.atlas.alpha, "Norm of the scaled normals (Eq. 2)")->capture_default_str()->check(CLI::PositiveNumber)->check(kFinite);
+  c->add_option("--lr", o.lr, "Adam learning rate")->capture_default_str()->check(CLI::PositiveNumber)->check(kFinite);
+  c->add_option("--decay", o.decay, "Learning-rate factor at each decay point")->capture_default_str()->check(CLI::Range(0.0, 1.0))->check(kFinite);
   c->add_option("--decay-at", o.decay_at, "Fractions of --iters where the learning rate decays")->capture_default_str()->check(CLI::Range(0.0, 1.0));
   c->add_option("--seed", o.seed, "Random seed (same seed and threads -> same run)")->capture_default_str();
-  c->add_option("--threads", a->threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
-  c->add_option("--w-6d", o.weights.surface, "lambda_6D on L_6D (Eq. 7)")->capture_default_str()->check(CLI::NonNegativeNumber);
-  c->add_option("--w-2d", o.weights.chart, "lambda_2D on L_2D (Eq. 8)")->capture_default_str()->check(CLI::NonNegativeNumber);
-  c->add_option("--w-cycle", o.weights.cycle, "lambda_cycle on L_cycle (Eq. 9; mean convention, = paper's 1/M on sums)")->capture_default_str()->check(CLI::NonNegativeNumber);
-  c->add_option("--w-iso", o.weights.isometry, "lambda_iso on L_iso (Eq. 10; mean convention, = paper's 1e-4/M on sums)")->capture_default_str()->check(CLI::NonNegativeNumber);
-  c->add_option("--w-rep", o.weights.repulsion, "lambda_rep on L_rep (Eq. 11)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  c->add_option("--threads", a->threads, "Threads (default: all cores; a resumed run keeps its own, as results depend on it)")->check(CLI::Range(0, 1024));
+  c->add_option("--w-6d", o.weights.surface, "lambda_6D on L_6D (Eq. 7)")->capture_default_str()->check(CLI::NonNegativeNumber)->check(kFinite);
+  c->add_option("--w-2d", o.weights.chart, "lambda_2D on L_2D (Eq. 8)")->capture_default_str()->check(CLI::NonNegativeNumber)->check(kFinite);
+  c->add_option("--w-cycle", o.weights.cycle, "lambda_cycle on L_cycle (Eq. 9->check(kFinite); mean convention, = paper's 1/M on sums)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  c->add_option("--w-iso", o.weights.isometry, "lambda_iso on L_iso (Eq. 10->check(kFinite); mean convention, = paper's 1e-4/M on sums)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  c->add_option("--w-rep", o.weights.repulsion, "lambda_rep on L_rep (Eq. 11)")->capture_default_str()->check(CLI::NonNegativeNumber)->check(kFinite);
   c->add_option("--table-row", a->table_row, "Ablation of the paper's Table 1: row 6..11 (11 = full method)")->check(CLI::Range(6, 11));
   c->add_flag("--no-normals", a->no_normals, "Ablation: 3D Chamfer without normals");
   c->add_flag("--no-repulsion", a->no_repulsion, "Ablation: no L_rep");
@@ -205,11 +217,11 @@ void add_fit(CLI::App& app) {
   c->add_flag("--no-chart", a->no_chart, "Ablation: no chart psi, no L_2D, no L_cycle");
   c->add_flag("--no-isometry", a->no_isometry, "Ablation: no L_iso");
   c->add_option("--preset", a->preset, "paper: M = K = 10^4, 5 x 256 MLPs (slow on a laptop)");
-  c->add_option("--pool", a->pool, "Surface samples drawn once from the input")->capture_default_str()->check(CLI::Range(Index(100), Index(10000000)));
-  c->add_option("--repulsion-tolerance", o.repulsion_tolerance, "Bound on the error of L_rep from its cut-off radius")->capture_default_str()->check(CLI::Range(1e-15, 1e-2));
+  c->add_option("--pool", o.pool, "Surface samples drawn once from the input")->capture_default_str()->check(CLI::Range(Index(100), Index(10000000)));
+  c->add_option("--repulsion-tolerance", o.repulsion_tolerance, "Bound on the error of L_rep from its cut-off radius")->capture_default_str()->check(CLI::Range(1e-15, 1e-2))->check(kFinite);
   c->add_option("--checkpoint-every", a->checkpoint_every, "Write model.ckpt every N iterations (0: only at the end)")->capture_default_str()->check(CLI::NonNegativeNumber);
   c->add_option("--mesh-resolution", a->mesh_resolution, "Grid cells across the domain for domain_mesh.obj")->capture_default_str()->check(CLI::Range(8, 4096));
-  c->add_option("--mesh-threshold", a->mesh_threshold, "Domain = {P >= t * median of P at the means}")->capture_default_str()->check(CLI::Range(0.0, 100.0));
+  c->add_option("--mesh-threshold", a->mesh_threshold, "Domain = {P >= t * median of P at the means}")->capture_default_str()->check(CLI::Range(0.0, 100.0))->check(kFinite);
   c->add_flag("-q,--quiet", a->quiet, "No progress output");
   c->callback([a]() { run_fit(*a); });
 }

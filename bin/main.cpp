@@ -15,6 +15,19 @@ int main(int argc, char** argv) {
   jsa::cli::add_correspond(app);
   jsa::cli::add_eval(app);
   jsa::cli::add_eval_corr(app);
+  // CLI11 would call an unknown word "extra arguments"; name it instead.
+  if (argc > 1 && argv[1][0] != '-') {
+    bool known = false;
+    std::string names;
+    for (const CLI::App* sub : app.get_subcommands({})) {
+      known = known || sub->get_name() == argv[1];
+      names += (names.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!known) {
+      std::cerr << "jsatlas: unknown command '" << argv[1] << "' (commands: " << names << "; see --help)\n";
+      return 2;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

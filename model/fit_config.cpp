@@ -1,5 +1,7 @@
 #include "model/fit_config.h"
 
+#include <cmath>
+
 #include <nlohmann/json.hpp>
 
 namespace jsa {
@@ -33,6 +35,9 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["decay"] = o.decay;
   j["seed"] = o.seed;
   j["repulsion_tolerance"] = o.repulsion_tolerance;
+  j["max_faults"] = o.max_faults;
+  j["pool"] = o.pool;
+  j["threads"] = o.threads;
   return j.dump(indent);
 }
 
@@ -81,8 +86,12 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   field(j, "", "decay", o.decay);
   field(j, "", "seed", o.seed);
   field(j, "", "repulsion_tolerance", o.repulsion_tolerance);
+  field(j, "", "max_faults", o.max_faults);
+  field(j, "", "pool", o.pool);
+  field(j, "", "threads", o.threads);
   if (o.atlas.gaussians <= 0 || o.atlas.width <= 0 || o.atlas.hidden_layers < 0 || o.points <= 0 ||
-      o.atlas.shapes <= 0 || o.atlas.code_size <= 0)
+      o.atlas.shapes <= 0 || o.atlas.code_size <= 0 || o.pool <= 0 || o.threads < 0 || !(o.lr > 0) ||
+      !std::isfinite(o.lr))
     throw InputError(what + ": sizes must be positive");
   return o;
 }

@@ -1,5 +1,6 @@
 #include "model/objective.h"
 
+#include <cmath>
 #include <limits>
 
 #include "engine/ops.h"
@@ -114,6 +115,12 @@ Var collection_objective(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>
     sum_terms.cycle_2d += one.cycle_2d / n;
     sum_terms.cycle_6d += one.cycle_6d / n;
     sum_terms.isometry += one.isometry / n;
+  }
+  if (!std::isfinite(sum_terms.surface) || !atlas.params.value(atlas.domain.means()).allFinite()) {
+    // A diverged step (see single_shape_objective): NaN for the trainer to catch.
+    sum_terms.total = std::numeric_limits<double>::quiet_NaN();
+    if (terms) *terms = sum_terms;
+    return t.constant(Block<T>::Constant(1, 1, std::numeric_limits<T>::quiet_NaN()));
   }
   if (o.components.repulsion) {
     const Var rep = repulsion(t, atlas.params.on(t, atlas.domain.means()), atlas.domain.sigma(),

@@ -28,6 +28,8 @@ struct FitOptions {
   uint64_t seed = 1;           // every random draw derives from it
   double repulsion_tolerance = 1e-7;  // cut-off error bound of L_rep
   int max_faults = 5;          // NaN/Inf recoveries in a row before giving up
+  Index pool = 200000;         // surface samples drawn once per shape (the targets' pool)
+  int threads = 0;             // threads of the run (0: all); results depend on seed and threads
 };
 
 struct Progress {
