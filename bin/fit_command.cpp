@@ -37,6 +37,7 @@ struct FitArgs {
   std::string preset;
   int mesh_resolution = 256;
   double mesh_threshold = 0.3;
+  double minutes = 0;  // > 0: size --iters to this wall-time budget
   bool quiet = false;
 };
 
@@ -104,11 +105,6 @@ void run_fit(FitArgs& a) {
   o.atlas.shapes = int(inputs.size());
   fs::create_directories(a.out_dir);
   const std::string dir = a.out_dir;
-  write_file_atomically(dir + "/config.json", [&](std::ostream& out) {
-    out << "{\n\"inputs\": [";
-    for (size_t i = 0; i < inputs.size(); ++i) out << (i ? ", " : "") << json_quote(inputs[i]);
-    out << "],\n\"settings\": " << fit_options_to_json(o) << "\n}\n";
-  });
 
   Trainer trainer(o, pools);
   LossLog log;
@@ -121,7 +117,17 @@ void run_fit(FitArgs& a) {
               << ", K = " << o.atlas.gaussians << ", MLP " << o.atlas.hidden_layers << "x" << o.atlas.width
               << ", " << max_threads() << " threads" << (resuming ? ", resumed at " + std::to_string(trainer.iteration()) : std::string()) << ")\n";
 
+  auto write_config = [&]() {
+  write_file_atomically(dir + "/config.json", [&](std::ostream& out) {
+      out << "{\n\"inputs\": [";
+      for (size_t i = 0; i < inputs.size(); ++i) out << (i ? ", " : "") << json_quote(inputs[i]);
+      out << "],\n\"settings\": " << fit_options_to_json(o) << "\n}\n";
+    });
+  
+  };
+  write_config();
   auto save = [&]() {
+    write_config();
     write_checkpoint(dir + "/model.ckpt", inputs, o, frames, trainer);
     write_loss_log(dir + "/losses.csv", log);
   };
@@ -131,7 +137,21 @@ void run_fit(FitArgs& a) {
   const auto start = clock::now();
   auto last_print = start;
   const int64_t first = trainer.iteration();
-  while (!trainer.finished()) {
+  // A time budget: time a few iterations, then set the run's length (and so its
+  // learning-rate schedule) to what fits. The length is recorded in the
+  // checkpoint, so a resumed run follows the same schedule.
+  const int64_t probe = 10;
+  bool sized = !(a.minutes > 0) || resuming;
+  while (!trainer.finished() || !sized) {
+    if (!sized && trainer.iteration() - first == probe) {
+      const double per = std::chrono::duration<double>(clock::now() - start).count() / double(probe);
+      const int64_t n = std::max<int64_t>(probe + 1, int64_t(a.minutes * 60.0 / per * 0.97));
+      trainer.set_iterations(n);
+      o.iterations = n;
+      sized = true;
+      if (!a.quiet) std::cerr << "fit: " << a.minutes << " min at " << per * 1e3 << " ms/iteration -> " << n << " iterations\n";
+    }
+    if (trainer.finished()) continue;
     const int64_t before = trainer.iteration();
     try {
       trainer.step();
@@ -203,6 +223,7 @@ void add_fit(CLI::App& app) {
   c->add_option("--lr", o.lr, "Adam learning rate")->capture_default_str()->check(CLI::PositiveNumber)->check(kFinite);
   c->add_option("--decay", o.decay, "Learning-rate factor at each decay point")->capture_default_str()->check(CLI::Range(0.0, 1.0))->check(kFinite);
   c->add_option("--decay-at", o.decay_at, "Fractions of --iters where the learning rate decays")->capture_default_str()->check(CLI::Range(0.0, 1.0));
+  c->add_option("--minutes", a->minutes, "Time budget: after 10 timed iterations, set --iters to fill it (the schedule follows)")->check(CLI::Range(0.01, 100000.0));
   c->add_option("--seed", o.seed, "Random seed (same seed and threads -> same run)")->capture_default_str();
   c->add_option("--threads", a->threads, "Threads (default: all cores; a resumed run keeps its own, as results depend on it)")->check(CLI::Range(0, 1024));
   c->add_option("--w-6d", o.weights.surface, "lambda_6D on L_6D (Eq. 7)")->capture_default_str()->check(CLI::NonNegativeNumber)->check(kFinite);

@@ -96,7 +96,9 @@ void nearest_kdtree(const Block<T>& queries, const Block<T>& points, std::vector
   const T* q = queries.data();
   const size_t c = size_t(queries.cols());
   T* dist = squared_distance ? squared_distance->data() : nullptr;
-#pragma omp parallel for schedule(dynamic, 256)
+// Small batches stay serial: a parallel region costs more than it saves, and
+  // far more when another process holds the second core.
+#pragma omp parallel for schedule(dynamic, 256) if (m > 1024)
   for (Index i = 0; i < m; ++i) {
     ClosestOne<T> best;
     tree.findNeighbors(best, q + size_t(i) * c, params);
@@ -142,7 +144,7 @@ void nearest_brute_force(const Block<T>& queries, const Block<T>& points, std::v
   const size_t c = size_t(points.cols());
   index.resize(m);
   if (squared_distance) squared_distance->resize(m);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (m > 64)
   for (Index i = 0; i < m; ++i) {
     const T* q = queries.data() + size_t(i) * c;
     T best = std::numeric_limits<T>::max();

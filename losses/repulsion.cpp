@@ -138,7 +138,7 @@ double repulsion_cutoff(const Block<T>& mu, T sigma, Block<T>* dmu, const Repuls
   const Index reach = Index(r_c / g.h) + 1;  // rows and columns a cell can see
   std::vector<double> rows(K);
 
-#pragma omp parallel
+#pragma omp parallel if (K > 1024)
   {
     // Per-thread scratch, grown when a cell needs more, never shrunk:
     // the candidates' coordinates, then d_ij and w_ij of one mean.

@@ -65,6 +65,9 @@ class Trainer {
   int64_t iteration() const { return iteration_; }
   const LossTerms& last() const { return last_; }
   bool finished() const { return iteration_ >= options_.iterations; }
+  // Changes the length of the run (and so the learning-rate schedule) before it
+  // reaches its first decay point: used to fit a run to a time budget.
+  void set_iterations(int64_t n) { options_.iterations = n; }
   Atlas<float>& atlas() { return *atlas_; }
   const FitOptions& options() const { return options_; }
   // The full state (parameters, Adam, RNG, iteration), for checkpoints.
