@@ -25,6 +25,8 @@ Evaluation evaluate_reconstruction(Atlas<float>& atlas, const Mesh& shape,
   Evaluation e;
   e.fit = surface_metrics(pp, pn, ap, a.normals);
   e.floor = surface_metrics(bp, b.normals, ap, a.normals);
+  e.fit_emd = emd_metrics(pp, pn, ap, a.normals);
+  e.floor_emd = emd_metrics(bp, b.normals, ap, a.normals);
   return e;
 }
 

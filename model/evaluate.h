@@ -2,9 +2,11 @@
 // x ~ P mapped through phi against M' fresh samples of the shape, in the
 // shape's unit frame; and the sampling floor, the same metrics between two
 // independent samples of the shape, which is the best a perfect fit can score.
+// Both under the Chamfer association and under the exact EMD assignment.
 #pragma once
 #include "io/mesh.h"
 #include "io/normalization.h"
+#include "losses/emd.h"
 #include "losses/metrics.h"
 #include "model/atlas.h"
 
@@ -16,8 +18,10 @@ struct EvaluationOptions {
 };
 
 struct Evaluation {
-  SurfaceMetrics fit;    // atlas vs shape
+  SurfaceMetrics fit;    // atlas vs shape (Chamfer association)
   SurfaceMetrics floor;  // shape vs an independent sample of itself
+  EmdMetrics fit_emd;    // the same pairs of sets under the exact EMD assignment (Eq. 13)
+  EmdMetrics floor_emd;
 };
 
 // `count` points of the reconstruction: uv ~ P, points = phi(uv), unit normals.
