@@ -75,10 +75,11 @@ void run_fit(FitArgs& a) {
     if (a.out_dir.empty()) throw InputError("fit: give an output directory with -o DIR");
     if (!a.preset.empty()) {
       if (a.preset != "paper") throw InputError("--preset: unknown preset '" + a.preset + "' (known: paper)");
-      o.points = 10000;
-      o.atlas.gaussians = 10000;
-      o.atlas.width = 256;
-      o.atlas.hidden_layers = 5;
+      const FitOptions paper = paper_fit_options();
+      o.points = paper.points;
+      o.atlas.gaussians = paper.atlas.gaussians;
+      o.atlas.width = paper.atlas.width;
+      o.atlas.hidden_layers = paper.atlas.hidden_layers;
     }
     if (a.table_row) o.components = Components::table_row(a.table_row);
     if (a.no_normals) o.components.normals = false;
