@@ -4,6 +4,7 @@
 // Exits non-zero if any of them disagree.
 #include <cmath>
 #include <cstdio>
+#include <exception>
 
 #include "engine/gradcheck.h"
 #include "engine/rng.h"
@@ -24,7 +25,7 @@ double chamfer_by_hand(const Block<double>& x, const Block<double>& y) {
   return one_way(x, y) + one_way(y, x);
 }
 
-int main() {
+int main() try {
   // X: 200 points on the unit circle; Y: 150 points on a circle of radius 1.2,
   // shifted. Random angles keep the nearest neighbours free of ties.
   Rng rng(3);
@@ -59,4 +60,7 @@ int main() {
   const bool ok = std::abs(t.scalar(cd) - by_hand) < 1e-12 && std::abs(plain - by_hand) < 1e-12 && check.ok;
   std::printf("%s\n", ok ? "ok" : "FAILED");
   return ok ? 0 : 1;
+} catch (const std::exception& e) {  // JSA_CHECK and InputError throw
+  std::fprintf(stderr, "example_chamfer_points: %s\n", e.what());
+  return 1;
 }

@@ -4,6 +4,7 @@
 // written as an OBJ with texture coordinates (io/mesh_io.h).
 // Usage: example_chart_mesh [out.obj]. Exits non-zero if the chart is unusable.
 #include <cstdio>
+#include <exception>
 #include <string>
 
 #include "engine/parallel.h"
@@ -57,7 +58,7 @@ int main(int argc, char** argv) try {
                   q.flipped_area_fraction < 0.2;
   std::printf("%s\n", ok ? "ok" : "FAILED");
   return ok ? 0 : 1;
-} catch (const std::exception& e) {
+} catch (const std::exception& e) {  // JSA_CHECK and InputError throw
   std::fprintf(stderr, "example_chart_mesh: %s\n", e.what());
   return 1;
 }

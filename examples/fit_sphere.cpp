@@ -1,17 +1,18 @@
 // Example: fit an atlas of the unit sphere with the Trainer (model/trainer.h).
-// FitOptions holds every setting with the paper's defaults; here they are made
-// small (K = 256 Gaussians, 3 x 32 MLPs, M = 256 points) so the fit takes a few
+// FitOptions holds every setting, each with a documented default; here they are
+// made small (K = 256 Gaussians, 3 x 32 MLPs, M = 256 points) so the fit takes a few
 // seconds. The library never prints: the loop below reports progress itself.
 // Exits non-zero if L_6D (Eq. 7) does not drop tenfold.
 #include <cmath>
 #include <cstdio>
+#include <exception>
 
 #include "engine/parallel.h"
 #include "model/trainer.h"
 
 using namespace jsa;
 
-int main() {
+int main() try {
   // The training targets: P x 6 rows [x_S, n_S] with unit normals. On the unit
   // sphere a point is its own normal.
   Rng rng(1);
@@ -51,4 +52,7 @@ int main() {
   const bool ok = last < 0.1 * first && last < 0.1;
   std::printf("%s\n", ok ? "ok" : "FAILED");
   return ok ? 0 : 1;
+} catch (const std::exception& e) {  // JSA_CHECK and InputError throw
+  std::fprintf(stderr, "example_fit_sphere: %s\n", e.what());
+  return 1;
 }

@@ -4,6 +4,7 @@
 // that evaluate the same weights point by point. Exits non-zero on a mismatch.
 #include <cmath>
 #include <cstdio>
+#include <exception>
 
 #include "engine/dual.h"
 #include "model/parametrize.h"
@@ -29,7 +30,7 @@ std::vector<D> phi_dual(const Parameters<double>& p, const MlpShape& shape, doub
   return h;
 }
 
-int main() {
+int main() try {
   const MlpShape shape{2, 3, 32, 3, 0};  // in, out, width, hidden layers, code size
   Parameters<double> p;
   const Parametrization<double> phi(p, shape, 0.01);  // alpha = 0.01
@@ -66,4 +67,7 @@ int main() {
   const bool ok = worst < 1e-12;  // the same arithmetic in another order: rounding only
   std::printf("%s\n", ok ? "ok" : "FAILED");
   return ok ? 0 : 1;
+} catch (const std::exception& e) {  // JSA_CHECK and InputError throw
+  std::fprintf(stderr, "example_jacobian_normals: %s\n", e.what());
+  return 1;
 }

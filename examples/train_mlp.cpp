@@ -4,6 +4,7 @@
 // Exits non-zero if the fit is poor or the gradient check fails.
 #include <cmath>
 #include <cstdio>
+#include <exception>
 
 #include "engine/adam.h"
 #include "engine/gradcheck.h"
@@ -19,7 +20,7 @@ Var network(Tape<T>& t, Var x, Var w1, Var b1, Var w2, Var b2) {
   return linear(t, relu(t, linear(t, x, w1, b1)), w2, b2);
 }
 
-int main() {
+int main() try {
   const Index n = 64;  // N training points
   Block<double> x(n, 1), y(n, 1);
   for (Index i = 0; i < n; ++i) {
@@ -58,4 +59,7 @@ int main() {
   const bool ok = loss < 0.01 && check.ok;
   std::printf("%s\n", ok ? "ok" : "FAILED");
   return ok ? 0 : 1;
+} catch (const std::exception& e) {  // JSA_CHECK and InputError throw
+  std::fprintf(stderr, "example_train_mlp: %s\n", e.what());
+  return 1;
 }
