@@ -19,7 +19,8 @@ constexpr double kPi = 3.14159265358979323846;
 double chamfer_by_hand(const Block<double>& x, const Block<double>& y) {
   auto one_way = [](const Block<double>& a, const Block<double>& b) {
     double total = 0;
-    for (Index i = 0; i < a.rows(); ++i) total += (b.rowwise() - a.row(i)).rowwise().squaredNorm().minCoeff();
+    for (Index i = 0; i < a.rows(); ++i)
+      total += (b.rowwise() - a.row(i)).rowwise().squaredNorm().minCoeff();
     return total / double(a.rows());
   };
   return one_way(x, y) + one_way(y, x);
@@ -47,17 +48,20 @@ int main() try {
   const double plain = chamfer_distance(x, y, &matches);
   const double by_hand = chamfer_by_hand(x, y);
   std::printf("CD(X, Y): tape %.10f  plain %.10f  by hand %.10f\n", t.scalar(cd), plain, by_hand);
-  std::printf("x_0 = (% .3f, % .3f) is matched to y_%d, dCD/dx_0 = (% .5f, % .5f)\n", x(0, 0), x(0, 1),
-              matches.x_to_y[0], t.grad(vx)(0, 0), t.grad(vx)(0, 1));
+  std::printf("x_0 = (% .3f, % .3f) is matched to y_%d, dCD/dx_0 = (% .5f, % .5f)\n", x(0, 0),
+              x(0, 1), matches.x_to_y[0], t.grad(vx)(0, 0), t.grad(vx)(0, 1));
 
   // Central differences on both sets (the matches are fixed for steps this small).
-  const GraphBuilder f = [](Tape<double>& t, const std::vector<Var>& in) { return chamfer(t, in[0], in[1]); };
+  const GraphBuilder f = [](Tape<double>& t, const std::vector<Var>& in) {
+    return chamfer(t, in[0], in[1]);
+  };
   const GradCheckResult check = check_gradients(f, {x, y});
   std::printf("gradient check: %d entries, worst relative error %.2e\n", check.checked,
               check.worst_relative);
   if (!check.ok) std::printf("%s\n", check.report.c_str());
 
-  const bool ok = std::abs(t.scalar(cd) - by_hand) < 1e-12 && std::abs(plain - by_hand) < 1e-12 && check.ok;
+  const bool ok =
+      std::abs(t.scalar(cd) - by_hand) < 1e-12 && std::abs(plain - by_hand) < 1e-12 && check.ok;
   std::printf("%s\n", ok ? "ok" : "FAILED");
   return ok ? 0 : 1;
 } catch (const std::exception& e) {  // JSA_CHECK and InputError throw

@@ -3,6 +3,8 @@
 // triangles torn across the cut get their own UV corners, and the mesh is
 // written as an OBJ with texture coordinates (io/mesh_io.h).
 // Usage: example_chart_mesh [out.obj]. Exits non-zero if the chart is unusable.
+#include "model/chart_mesh.h"
+
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -10,7 +12,6 @@
 #include "engine/parallel.h"
 #include "io/mesh_io.h"
 #include "losses/uv_quality.h"
-#include "model/chart_mesh.h"
 #include "model/domain_mesh.h"
 #include "model/shape_input.h"
 #include "model/trainer.h"
@@ -35,8 +36,9 @@ int main(int argc, char** argv) try {
   set_threads(o.threads);
   Trainer trainer(o, in.pool);
   while (!trainer.finished()) trainer.step();
-  std::printf("fit: %lld iterations, L_6D %.4f, L_2D %.4f\n", static_cast<long long>(trainer.iteration()),
-              trainer.last().surface, trainer.last().chart);
+  std::printf("fit: %lld iterations, L_6D %.4f, L_2D %.4f\n",
+              static_cast<long long>(trainer.iteration()), trainer.last().surface,
+              trainer.last().chart);
 
   // psi([x, alpha n]) at every vertex, then domain -> [0, 1]^2 texture space.
   Atlas<float>& atlas = trainer.atlas();

@@ -2,9 +2,12 @@
 // of a parametrization, from one pass of stacked tangent rows [x; e_u; e_v]
 // through phi (model/parametrize.h), checked against forward-mode dual numbers
 // that evaluate the same weights point by point. Exits non-zero on a mismatch.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <string>
+#include <vector>
 
 #include "engine/dual.h"
 #include "model/parametrize.h"
@@ -56,12 +59,13 @@ int main() try {
     }
     // Eq. 2, with the tape's guard: row_normalize divides by sqrt(|c|^2 + 1e-12)
     // (engine/ops.h) so that a degenerate J has a finite gradient.
-    const Eigen::Vector3d c = ju.cross(jv);
-    const Eigen::Vector3d n = phi.alpha() * c / std::sqrt(c.squaredNorm() + 1e-12);
+    const Eigen::Vector3d cross = ju.cross(jv);
+    const Eigen::Vector3d n = phi.alpha() * cross / std::sqrt(cross.squaredNorm() + 1e-12);
     for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(t.value(s.normals)(i, c) - n[c]));
     if (i < 3)
-      std::printf("x = (%.3f, %.3f)  J_u = (% .4f % .4f % .4f)  n/alpha = (% .4f % .4f % .4f)\n", x(i, 0),
-                  x(i, 1), ju[0], ju[1], ju[2], n[0] / phi.alpha(), n[1] / phi.alpha(), n[2] / phi.alpha());
+      std::printf("x = (%.3f, %.3f)  J_u = (% .4f % .4f % .4f)  n/alpha = (% .4f % .4f % .4f)\n",
+                  x(i, 0), x(i, 1), ju[0], ju[1], ju[2], n[0] / phi.alpha(), n[1] / phi.alpha(),
+                  n[2] / phi.alpha());
   }
   std::printf("largest difference, tape vs duals (phi, J_u, J_v, n): %.2e\n", worst);
   const bool ok = worst < 1e-12;  // the same arithmetic in another order: rounding only

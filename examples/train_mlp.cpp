@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <vector>
 
 #include "engine/adam.h"
 #include "engine/gradcheck.h"

@@ -24,8 +24,8 @@ int main(int argc, char** argv) try {
   const jsa::SurfacePoints s = atlas.phi.evaluate(tape, atlas.params, x, /*with_jacobian=*/true);
   const jsa::Block<float>& phi6 = tape.value(s.phi6);  // 5 x 6 [phi(x), n]
   for (jsa::Index i = 0; i < phi6.rows(); ++i)
-    std::printf("phi(% .3f, % .3f) = (% .4f % .4f % .4f)\n", tape.value(x)(i, 0), tape.value(x)(i, 1),
-                phi6(i, 0), phi6(i, 1), phi6(i, 2));
+    std::printf("phi(% .3f, % .3f) = (% .4f % .4f % .4f)\n", tape.value(x)(i, 0),
+                tape.value(x)(i, 1), phi6(i, 0), phi6(i, 1), phi6(i, 2));
 
   const std::string path = argc > 1 ? argv[1] : "consumer_cube.obj";
   const jsa::Mesh cube = jsa::builtin_shape("cube", 8);
