@@ -11,31 +11,12 @@
 #include "engine/check.h"
 #include "io/input_file.h"
 
+#include "test/scratch.h"
+
+using test_support::ScratchDir;
+using test_support::message_of;
+
 namespace {
-
-// A fresh directory under /tmp, removed with everything in it at the end of the test.
-struct ScratchDir {
-  std::string path;
-  ScratchDir() {
-    char pattern[] = "/tmp/jsatlas_io_input_XXXXXX";
-    path = ::mkdtemp(pattern);
-  }
-  ~ScratchDir() { std::filesystem::remove_all(path); }
-  std::string file(const std::string& name, const std::string& bytes) const {
-    const std::string full = path + "/" + name;
-    std::ofstream(full, std::ios::binary) << bytes;
-    return full;
-  }
-};
-
-std::string message_of(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const jsa::InputError& e) {
-    return e.what();
-  }
-  return "<no InputError thrown>";
-}
 
 }  // namespace
 

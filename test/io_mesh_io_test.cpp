@@ -11,30 +11,12 @@
 #include "io/builtin_shapes.h"
 #include "io/mesh_io.h"
 
+#include "test/scratch.h"
+
+using test_support::ScratchDir;
+using test_support::message_of;
+
 namespace {
-
-struct ScratchDir {
-  std::string path;
-  ScratchDir() {
-    char pattern[] = "/tmp/jsatlas_io_mesh_XXXXXX";
-    path = ::mkdtemp(pattern);
-  }
-  ~ScratchDir() { std::filesystem::remove_all(path); }
-  std::string file(const std::string& name, const std::string& bytes) const {
-    const std::string full = path + "/" + name;
-    std::ofstream(full, std::ios::binary) << bytes;
-    return full;
-  }
-};
-
-std::string message_of(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const jsa::InputError& e) {
-    return e.what();
-  }
-  return "<no InputError thrown>";
-}
 
 std::string slurp(const std::string& path) {
   std::ifstream in(path);
@@ -201,4 +183,17 @@ TEST_CASE("bad OFF content is rejected with the line", "[io][mesh_io]") {
                 "line 6: face line must be");
   check_rejects(dir, "short.off", "OFF\n3 1 0\n0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
                 "line 3: vertex line has 2 numbers");
+}
+
+// Inputs found by test/fuzz/fuzz_read_obj and fuzz_read_xyz, kept as regression tests.
+TEST_CASE("fuzz regressions: OBJ normal index past the vn lines, point table without points",
+          "[io][mesh_io][fuzz]") {
+  ScratchDir dir;
+  // Was an ASan heap-buffer-overflow reading attrib.normals in gather_faces.
+  check_rejects(dir, "normal_index.obj",
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1/1/1 2/2/1 3/3/9\n",
+                "a face refers to normal 9 but the file has 1 'vn' lines");
+  // Was UBSan "applying non-zero offset 24 to null pointer" in an empty Eigen map.
+  check_rejects(dir, "comments.xyz", "2\n# c2\n# comment\n", "no points");
+  check_rejects(dir, "only_comment.xyz", "# nothing\n", "no points");
 }

@@ -6,16 +6,12 @@
 #include "engine/check.h"
 #include "io/mesh_validation.h"
 
-namespace {
+#include "test/scratch.h"
 
-std::string message_of(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const jsa::InputError& e) {
-    return e.what();
-  }
-  return "<no InputError thrown>";
-}
+using test_support::ScratchDir;
+using test_support::message_of;
+
+namespace {
 
 // Two triangles sharing the edge 1-2, in the plane z = 0, both facing +z.
 jsa::Mesh two_triangles() {
