@@ -17,5 +17,6 @@ void add_mesh(CLI::App& app);
 void add_chart(CLI::App& app);
 void add_correspond(CLI::App& app);
 void add_eval_corr(CLI::App& app);
+void add_show(CLI::App& app);
 
 }  // namespace jsa::cli

@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   jsa::cli::add_fit(app);
   jsa::cli::add_mesh(app);
   jsa::cli::add_chart(app);
+  jsa::cli::add_show(app);
   jsa::cli::add_correspond(app);
   jsa::cli::add_eval(app);
   jsa::cli::add_eval_corr(app);

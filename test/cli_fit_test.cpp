@@ -7,9 +7,13 @@
 #include <thread>
 #include <unistd.h>
 
+#include <tiny_obj_loader.h>
+
+#include "io/builtin_shapes.h"
 #include "test/cli_test_support.h"
 
 using namespace cli_test;
+using jsa::Index;
 namespace fs = std::filesystem;
 
 namespace {
@@ -40,6 +44,11 @@ TEST_CASE("cli: fit writes every output and the follow-up commands read them", "
   CHECK(r.code == 0);
   r = run("mesh " + dir + " -o " + dir + "/m.obj --resolution 40 -q");
   CHECK(r.code == 0);
+  // `show` regenerates the pictures from the checkpoint.
+  fs::remove(dir + "/domain.png");
+  r = run("show " + dir + " -q");
+  CHECK(r.code == 0);
+  CHECK(fs::exists(dir + "/domain.png"));
   r = run("eval " + dir + " --samples 300");
   INFO(r.output);
   CHECK(r.code == 0);
@@ -79,4 +88,32 @@ TEST_CASE("cli: SIGKILL at a random moment leaves a loadable checkpoint", "[cli]
   const int done = count_lines(loss_rows(dir));
   CHECK(done % 5 == 0);  // losses.csv is rewritten with each checkpoint, never torn
   CHECK(done > 0);
+}
+
+TEST_CASE("cli: the chart OBJ reads back in tinyobjloader with one vt per input vertex, faces in order",
+          "[cli]") {
+  const std::string dir = fresh_dir("objback");
+  REQUIRE(run("fit builtin:torus -o " + dir + " --iters 10" + kSmall).code == 0);
+  const jsa::Mesh input = jsa::builtin_shape("torus");
+  for (const bool split : {false, true}) {
+    const std::string path = split ? dir + "/split.obj" : dir + "/input_chart.obj";
+    if (split) REQUIRE(run("chart " + dir + " -o " + path + " --split-cuts --torn-ratio 2 -q").code == 0);
+    tinyobj::ObjReader reader;
+    REQUIRE(reader.ParseFromFile(path));
+    const auto& attrib = reader.GetAttrib();
+    REQUIRE(reader.GetShapes().size() == 1);
+    const auto& indices = reader.GetShapes()[0].mesh.indices;
+    CHECK(attrib.vertices.size() == size_t(3 * input.vertices.rows()));
+    if (!split) CHECK(attrib.texcoords.size() == size_t(2 * input.vertices.rows()));
+    else CHECK(attrib.texcoords.size() >= size_t(2 * input.vertices.rows()));
+    REQUIRE(indices.size() == size_t(3 * input.faces.rows()));
+    bool same_order = true, uv_in_range = true;
+    for (size_t k = 0; k < indices.size(); ++k) {
+      same_order = same_order && indices[k].vertex_index == input.faces(Index(k / 3), int(k % 3));
+      if (!split) same_order = same_order && indices[k].texcoord_index == indices[k].vertex_index;
+    }
+    for (float t : attrib.texcoords) uv_in_range = uv_in_range && t > -0.5f && t < 1.5f;
+    CHECK(same_order);
+    CHECK(uv_in_range);
+  }
 }
