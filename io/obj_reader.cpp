@@ -20,7 +20,7 @@ std::string first_line(const std::string& text) {
   return line;
 }
 
-void gather_faces(const tinyobj::ObjReader& reader, Mesh& mesh) {
+void gather_faces(const std::string& path, const tinyobj::ObjReader& reader, Mesh& mesh) {
   const tinyobj::attrib_t& attrib = reader.GetAttrib();
   const Index vertex_count = mesh.vertices.rows();
   const bool with_normals = !attrib.normals.empty();
@@ -32,6 +32,12 @@ void gather_faces(const tinyobj::ObjReader& reader, Mesh& mesh) {
       const int n = corner.normal_index;
       if (!with_normals || n < 0 || corner.vertex_index < 0 || corner.vertex_index >= vertex_count)
         continue;
+      // tinyobjloader does not check `vn` indices against the `vn` lines read
+      // ("f 1//9" with one vn); found by fuzz_read_obj as a heap overflow here.
+      if (3 * std::size_t(n) + 2 >= attrib.normals.size())
+        input_error(path, "",
+                    "a face refers to normal " + std::to_string(n + 1) + " but the file has " +
+                        std::to_string(attrib.normals.size() / 3) + " 'vn' lines");
       normal_sums.row(corner.vertex_index) +=
           Eigen::RowVector3d(attrib.normals[3 * n], attrib.normals[3 * n + 1],
                              attrib.normals[3 * n + 2])
@@ -60,7 +66,7 @@ Mesh read_obj(const std::string& path) {
       Eigen::Map<const ObjRows>(attrib.vertices.data(), Index(attrib.vertices.size() / 3), 3)
           .cast<double>();
   mesh.normals.resize(0, 3);
-  gather_faces(reader, mesh);
+  gather_faces(path, reader, mesh);
   if (mesh.faces.rows() == 0 && !attrib.normals.empty()) {
     if (attrib.normals.size() != attrib.vertices.size())
       input_error(path, "",

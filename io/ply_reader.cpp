@@ -161,6 +161,13 @@ void check_declared_sizes(const std::string& path, const PlyHeader& header, std:
   }
 }
 
+// A value read from the file, printed as an integer when it is one.
+std::string shown(double value) {
+  if (value == std::floor(value) && std::abs(value) < 1e15)
+    return std::to_string(static_cast<long long>(value));
+  return std::to_string(value);
+}
+
 // Reads one value at a time from the body, in either encoding, with a `where`
 // for errors: "line N" (ascii) or "element 'face' row 3 field 'vertex_indices'".
 class PlyBody {
@@ -205,7 +212,9 @@ class PlyBody {
   // The length that opens a list value; a negative one means a corrupt file.
   double list_length(const PlyProperty& property) {
     const double n = value(property.count_type, property.name);
-    if (n < 0) fail(property.name, "negative list length " + std::to_string(int64_t(n)));
+    // shown(), not int64_t(n): an ascii length such as -1e300 does not fit an
+    // integer, and converting it would be undefined behaviour (found by fuzz_read_ply).
+    if (n < 0) fail(property.name, "negative list length " + shown(n));
     return n;
   }
 
@@ -258,13 +267,6 @@ class PlyBody {
   std::int64_t row_ = 0;
   const std::string* field_ = nullptr;
 };
-
-// A value read from the file, printed as an integer when it is one.
-std::string shown(double value) {
-  if (value == std::floor(value) && std::abs(value) < 1e15)
-    return std::to_string(static_cast<long long>(value));
-  return std::to_string(value);
-}
 
 int find_property(const PlyElement& element, const std::string& name) {
   for (std::size_t i = 0; i < element.properties.size(); ++i)
@@ -338,6 +340,10 @@ void read_faces(const std::string& path, const PlyElement& element, PlyBody& bod
 }
 
 void skip_element(const PlyElement& element, PlyBody& body) {
+  // Rows without properties hold no values: nothing to skip. Reading them anyway
+  // would take one ascii line per row that belongs to the next element, and spin
+  // through a declared count of 10^15 such rows in a binary file.
+  if (element.properties.empty()) return;
   for (std::int64_t r = 0; r < element.count; ++r) {
     body.start_row(element, r);
     for (const PlyProperty& property : element.properties) {

@@ -40,6 +40,9 @@ Mesh read_point_table(const std::string& path) {
       values.push_back(value);
     }
   }
+  // Without a point, the map below would be an offset from a null pointer
+  // (UBSan, found by fuzz_read_xyz on a file of comments).
+  if (values.empty()) input_error(path, "", "no points: expected lines 'x y z nx ny nz'");
   const Index count = Index(values.size() / 6);
   const Eigen::Map<const Block<double>> table(values.data(), count, 6);
   Mesh mesh;

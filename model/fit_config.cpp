@@ -1,12 +1,45 @@
 #include "model/fit_config.h"
 
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <type_traits>
 
 #include <nlohmann/json.hpp>
 
 namespace jsa {
 
 using nlohmann::json;
+
+namespace {
+
+// Whether the JSON number `value` fits the integer type T. nlohmann's get_to
+// converts with static_cast: undefined behaviour for 1e300 into an int (UBSan,
+// found by fuzzing fit_options_from_json), a silent wrap for 10^10. Non-numbers
+// and non-integer T pass here; get_to reports a wrong type itself.
+template <class T>
+bool fits(const json& value) {
+  if constexpr (!std::is_integral_v<T> || std::is_same_v<T, bool>) {
+    return true;
+  } else {
+    using Limits = std::numeric_limits<T>;
+    if (value.is_number_float()) {
+      const double d = value.get<double>();
+      const double bound = std::ldexp(1.0, Limits::digits);  // 2^31 for int, 2^64 for uint64_t
+      return d == std::floor(d) && d < bound && d >= (Limits::is_signed ? -bound : 0.0);
+    }
+    if (value.is_number_unsigned())
+      return value.get<std::uint64_t>() <= std::uint64_t(Limits::max());
+    if (value.is_number_integer()) {
+      const std::int64_t v = value.get<std::int64_t>();
+      if (v < 0) return Limits::is_signed && v >= std::int64_t(Limits::min());
+      return std::uint64_t(v) <= std::uint64_t(Limits::max());
+    }
+    return true;
+  }
+}
+
+}  // namespace
 
 std::string fit_options_to_json(const FitOptions& o, int indent) {
   json j;
@@ -52,6 +85,8 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   auto field = [&](const json& obj, const char* path, const char* key, auto& out) {
     if (!obj.is_object() || !obj.contains(key))
       throw InputError(what + ": missing field '" + std::string(path) + key + "'");
+    if (!fits<std::decay_t<decltype(out)>>(obj.at(key)))
+      throw InputError(what + ": field '" + std::string(path) + key + "' is out of range");
     try {
       obj.at(key).get_to(out);
     } catch (const std::exception&) {

@@ -315,3 +315,43 @@ TEST_CASE("corrupted PLY and OFF files only ever raise InputError", "[io][ply]")
     }
   CHECK(rejected > trials / 4);  // the corruption does get noticed
 }
+
+// Inputs found by test/fuzz/fuzz_read_ply, kept as regression tests.
+TEST_CASE("fuzz regressions: PLY list lengths past int64 and rows without properties",
+          "[io][ply][fuzz]") {
+  ScratchDir dir;
+  const std::string vertex_header =
+      "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+  SECTION("an ascii list length of -1e300 is reported, not converted to an integer") {
+    // Was UBSan "-1e+300 is outside the range of representable values of type 'long'".
+    const std::string path = dir.file(
+        "huge_negative_list.ply",
+        "ply\nformat ascii 1.0\nelement vertex 1\nproperty list uchar float junk\n"
+        "property float x\nproperty float y\nproperty float z\nend_header\n-1e300 0 0 0\n");
+    const std::string m = message_of([&] { jsa::read_shape(path); });
+    INFO(m);
+    CHECK(m.find("field 'junk': negative list length -1") != std::string::npos);
+  }
+  SECTION("an element without properties takes no ascii lines") {
+    // Rows of an element with no properties used to swallow the next element's lines.
+    const std::string path = dir.file(
+        "empty_element.ply", "ply\nformat ascii 1.0\nelement nothing 2\n" + vertex_header +
+                                 "element face 1\nproperty list uchar int vertex_indices\n"
+                                 "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    const jsa::Mesh mesh = jsa::read_shape(path);
+    CHECK(mesh.vertices.rows() == 3);
+    CHECK(mesh.faces.rows() == 1);
+  }
+  SECTION("a binary element of 10^15 rows without properties is read at once") {
+    std::string bytes = "ply\nformat binary_little_endian 1.0\nelement nothing 1000000000000000\n" +
+                        vertex_header + "element face 1\nproperty list uchar int vertex_indices\n"
+                                        "end_header\n";
+    const float xyz[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    bytes.append(reinterpret_cast<const char*>(xyz), sizeof xyz);
+    const std::int32_t face[3] = {0, 1, 2};
+    bytes += char(3);
+    bytes.append(reinterpret_cast<const char*>(face), sizeof face);
+    const jsa::Mesh mesh = jsa::read_shape(dir.file("empty_rows.ply", bytes));
+    CHECK(mesh.faces.rows() == 1);
+  }
+}

@@ -1,0 +1,60 @@
+// FitOptions from JSON (a checkpoint's settings): every malformed text is an
+// InputError naming the source and the field, never a crash or a wrapped number.
+#include <catch2/catch.hpp>
+#include <string>
+
+#include "engine/check.h"
+#include "model/fit_config.h"
+
+namespace {
+
+std::string message_of(const std::string& text) {
+  try {
+    jsa::fit_options_from_json(text, "run/model.ckpt");
+  } catch (const jsa::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// The defaults written out, with `from` (first occurrence) replaced by `to`.
+std::string edited(const std::string& from, const std::string& to) {
+  std::string text = jsa::fit_options_to_json(jsa::FitOptions(), -1);
+  const auto at = text.find(from);
+  REQUIRE(at != std::string::npos);
+  return text.replace(at, from.size(), to);
+}
+
+}  // namespace
+
+TEST_CASE("fit config: the defaults round-trip through JSON", "[fit_config]") {
+  const jsa::FitOptions o =
+      jsa::fit_options_from_json(jsa::fit_options_to_json(jsa::FitOptions()), "x");
+  CHECK(o.atlas.gaussians == jsa::FitOptions().atlas.gaussians);
+  CHECK(o.seed == jsa::FitOptions().seed);
+}
+
+TEST_CASE("fit config: malformed JSON is rejected naming the source and the field",
+          "[fit_config]") {
+  CHECK(message_of("{\"atlas\": 3").find("run/model.ckpt: not valid JSON") == 0);
+  CHECK(message_of("[1, 2]") == "run/model.ckpt: expected a JSON object");
+  CHECK(message_of("{}") == "run/model.ckpt: missing field 'atlas.gaussians'");
+  CHECK(message_of(edited("\"lr\":", "\"lr_\":")) == "run/model.ckpt: missing field 'lr'");
+  CHECK(message_of(edited("\"width\":", "\"width\":\"wide\",\"w\":")) ==
+        "run/model.ckpt: field 'atlas.width' has the wrong type");
+  CHECK(message_of(edited("\"points\":", "\"points\":-3,\"p\":")) ==
+        "run/model.ckpt: sizes must be positive");
+}
+
+// Found by test/fuzz/fuzz_fit_config: nlohmann's static_cast of 1e300 into an int
+// was undefined behaviour (UBSan float-cast-overflow); 10^10 wrapped silently.
+TEST_CASE("fuzz regressions: integer fields out of their type's range", "[fit_config][fuzz]") {
+  const std::string out_of_range = "run/model.ckpt: field 'atlas.gaussians' is out of range";
+  CHECK(message_of(edited("\"gaussians\":", "\"gaussians\":1e300,\"g\":")) == out_of_range);
+  CHECK(message_of(edited("\"gaussians\":", "\"gaussians\":10000000000,\"g\":")) == out_of_range);
+  CHECK(message_of(edited("\"gaussians\":", "\"gaussians\":2.5,\"g\":")) == out_of_range);
+  CHECK(message_of(edited("\"seed\":", "\"seed\":-1,\"s\":")) ==
+        "run/model.ckpt: field 'seed' is out of range");
+  CHECK(message_of(edited("\"gaussians\":", "\"gaussians\":12.0,\"g\":"))
+            .empty());  // a whole float is fine
+}
