@@ -92,10 +92,8 @@ void write_chart(Atlas<float>& atlas, const Normalization& normalization, const 
                                       {"split_cuts", o.split_cuts}, {"torn_before_split", torn_before}});
   const Block<double> vertex_vt = frame.to_texture(uv);
   write_png(stem + ".png", domain_coloured_views(mesh.vertices, mesh.faces, vertex_vt));
-  std::vector<bool> highlight(size_t(mesh.faces.rows()), false);
-  for (int f : q.torn_faces) highlight[size_t(f)] = true;
-  for (int f : q.flipped_faces) highlight[size_t(f)] = true;
-  write_png(stem + "_layout.png", uv_layout_picture(mesh.vertices, mesh.faces, vt, uv_faces, highlight));
+  write_png(stem + "_layout.png",
+            uv_layout_picture(mesh.vertices, mesh.faces, vt, uv_faces, q.flipped_faces, q.torn_faces));
   if (!o.quiet) {
     std::cerr << "chart: " << obj_path << "  (" << mesh.vertices.rows() << " vertices, " << mesh.faces.rows()
               << " faces in the input's order; " << torn_before << " torn across the cut"

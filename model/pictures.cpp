@@ -75,11 +75,29 @@ Image domain_coloured_views(const Block<double>& vertices, const Faces& faces,
 }
 
 Image uv_layout_picture(const Block<double>& vertices, const Faces& faces, const Block<double>& texture_uv,
-                        const Faces& uv_faces, const std::vector<bool>& highlight, int size) {
+                        const Faces& uv_faces, const std::vector<int>& flipped, const std::vector<int>& torn,
+                        int size) {
+  std::vector<bool> is_torn(size_t(faces.rows()), false);
+  for (int f : torn) is_torn[size_t(f)] = true;
   const Block<double> fn = face_normals(vertices, faces);
-  std::vector<Eigen::Vector3d> colour(size_t(faces.rows()));
-  for (Index f = 0; f < faces.rows(); ++f) colour[size_t(f)] = (0.5 * (fn.row(f).transpose().array() + 1)).matrix();
-  return draw_uv_layout(texture_uv, uv_faces, colour, highlight, size);
+  Faces kept(faces.rows() - Index(torn.size()), 3);
+  std::vector<Eigen::Vector3d> colour;
+  std::vector<bool> highlight;
+  std::vector<bool> is_flipped(size_t(faces.rows()), false);
+  for (int f : flipped) is_flipped[size_t(f)] = true;
+  for (Index f = 0, k = 0; f < faces.rows(); ++f) {
+    if (is_torn[size_t(f)]) continue;
+    kept.row(k++) = uv_faces.row(f);
+    colour.push_back((0.5 * (fn.row(f).transpose().array() + 1)).matrix());
+    highlight.push_back(is_flipped[size_t(f)]);
+  }
+  Image image = draw_uv_layout(texture_uv, kept, colour, highlight, size);
+  for (int f : torn)
+    for (int c = 0; c < 3; ++c) {
+      const Index v = uv_faces(f, c);
+      fill_circle(image, {texture_uv(v, 0) * size, (1 - texture_uv(v, 1)) * size}, 1.5, colours::red());
+    }
+  return image;
 }
 
 }  // namespace jsa

@@ -21,8 +21,10 @@ Image loss_curves(const LossLog& log);
 // texture_uv: V x 2 in [0,1]^2 (TextureFrame coordinates) giving each vertex its colour.
 Image domain_coloured_views(const Block<double>& vertices, const Faces& faces,
                             const Block<double>& texture_uv, int size = 384);
+// flipped faces are outlined in red; torn faces (which span the cut, across the
+// whole layout) are left unfilled and marked by red dots at their corners.
 Image uv_layout_picture(const Block<double>& vertices, const Faces& faces,
                         const Block<double>& texture_uv, const Faces& uv_faces,
-                        const std::vector<bool>& highlight, int size = 768);
+                        const std::vector<int>& flipped, const std::vector<int>& torn, int size = 768);
 
 }  // namespace jsa
