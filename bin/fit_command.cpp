@@ -36,7 +36,7 @@ struct FitArgs {
        no_isometry = false;
   std::string preset;
   int mesh_resolution = 256;
-  double mesh_threshold = 0.3;
+  double mesh_threshold = 0.05;
   double minutes = 0;  // > 0: size --iters to this wall-time budget
   bool quiet = false;
 };

@@ -14,7 +14,7 @@ std::string json_quote(const std::string& s);
 
 struct MeshOutputOptions {
   int resolution = 256;    // grid cells across the domain
-  double threshold = 0.3;  // domain = {P >= threshold * median of P at the means}
+  double threshold = 0.05;  // domain = {P >= threshold * median of P at the means}
   bool quiet = false;
 };
 // OUT.obj (+ .mtl, texture PNG, _uv.json report, .png three views): the
