@@ -213,7 +213,7 @@ class PlyBody {
   double list_length(const PlyProperty& property) {
     const double n = value(property.count_type, property.name);
     // shown(), not int64_t(n): an ascii length such as -1e300 does not fit an
-    // integer, and converting it would be undefined behaviour (found by fuzz_read_ply).
+    // integer, and converting it would be undefined behaviour (UBSan in fuzz_read_ply).
     if (n < 0) fail(property.name, "negative list length " + shown(n));
     return n;
   }

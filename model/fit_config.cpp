@@ -14,9 +14,9 @@ using nlohmann::json;
 namespace {
 
 // Whether the JSON number `value` fits the integer type T. nlohmann's get_to
-// converts with static_cast: undefined behaviour for 1e300 into an int (UBSan,
-// found by fuzzing fit_options_from_json), a silent wrap for 10^10. Non-numbers
-// and non-integer T pass here; get_to reports a wrong type itself.
+// converts with static_cast: undefined behaviour for 1e300 into an int (UBSan in
+// fuzz_fit_config), a silent wrap for 10^10. Non-numbers and non-integer T pass
+// here; get_to reports a wrong type itself.
 template <class T>
 bool fits(const json& value) {
   if constexpr (!std::is_integral_v<T> || std::is_same_v<T, bool>) {

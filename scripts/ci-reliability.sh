@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# Reliability CI (issue 8): (a) the whole test suite under AddressSanitizer +
+# UndefinedBehaviorSanitizer, (b) each libFuzzer target for a bounded time on its
+# seed corpus (test/fuzz/corpus/<target>). Prints how long each step took.
+# Builds in build-asan/ and build-fuzz/; installs clang-14 and libclang-rt-14-dev
+# when missing. FUZZ_SECONDS sets the time per target (default 30).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+fuzz_seconds="${FUZZ_SECONDS:-30}"
+jobs=2
+
+# "step NAME COMMAND...": runs COMMAND, then prints NAME and its wall time.
+step() {
+  local name="$1" start=$SECONDS
+  shift
+  "$@"
+  echo "ci-reliability: $name took $((SECONDS - start)) s"
+}
+
+install_clang() {
+  local missing=()
+  for p in clang-14 libclang-rt-14-dev; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  local sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  echo "ci-reliability: installing ${missing[*]}"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${missing[@]}"
+}
+
+# -O1 keeps the sanitizer build affordable on two cores; no benchmarks.
+build_asan() {
+  cmake -S . -B build-asan -DJSATLAS_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DJSATLAS_BUILD_BENCH=OFF "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG" > /dev/null
+  cmake --build build-asan -j "$jobs"
+}
+
+test_asan() {
+  # halt_on_error: the first report fails the test; leaks are reported too.
+  ASAN_OPTIONS=detect_leaks=1:halt_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    ctest --test-dir build-asan --output-on-failure -j "$jobs"
+}
+
+build_fuzz() {
+  cmake -S . -B build-fuzz -DJSATLAS_FUZZ=ON -DCMAKE_CXX_COMPILER=clang++-14 \
+    -DJSATLAS_BUILD_TESTS=OFF -DJSATLAS_BUILD_BENCH=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" > /dev/null
+  cmake --build build-fuzz -j "$jobs" --target fuzz
+}
+
+# Fuzzes one target; new inputs go to a scratch corpus, the seeds stay as they are.
+# A crash, a timeout (>10 s on one input), 2 GB of memory or a sanitizer report
+# fails the step; the input is kept as build-fuzz/artifacts/<target>/crash-*.
+run_fuzzer() {
+  local target="$1"
+  local scratch="build-fuzz/corpus/$target" artifacts="build-fuzz/artifacts/$target"
+  mkdir -p "$scratch" "$artifacts"
+  "build-fuzz/test/fuzz/$target" "$scratch" "test/fuzz/corpus/$target" \
+    -max_total_time="$fuzz_seconds" -timeout=10 -rss_limit_mb=2048 \
+    -artifact_prefix="$artifacts/" -print_final_stats=1 > "build-fuzz/$target.log" 2>&1 || {
+    tail -n 60 "build-fuzz/$target.log"
+    echo "ci-reliability: $target found a bug; the input is in $artifacts/"
+    return 1
+  }
+  grep -E "^#[0-9]+ +DONE" "build-fuzz/$target.log" || true
+}
+
+total_start=$SECONDS
+step "sanitizer build" build_asan
+step "sanitizer tests" test_asan
+step "clang install check" install_clang
+step "fuzz build" build_fuzz
+for target in fuzz_read_obj fuzz_read_off fuzz_read_ply fuzz_read_xyz fuzz_read_keypoints \
+              fuzz_read_checkpoint fuzz_fit_config; do
+  step "$target (${fuzz_seconds} s)" run_fuzzer "$target"
+done
+echo "ci-reliability: all steps took $((SECONDS - total_start)) s"
