@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <sstream>
 
 #include "io/input_file.h"
 #include "io/shape_readers.h"
@@ -161,11 +162,14 @@ void check_declared_sizes(const std::string& path, const PlyHeader& header, std:
   }
 }
 
-// A value read from the file, printed as an integer when it is one.
+// A value read from the file, printed as an integer when it is one, else with
+// six significant digits ("-1e+300", not a 300-digit std::to_string).
 std::string shown(double value) {
   if (value == std::floor(value) && std::abs(value) < 1e15)
     return std::to_string(static_cast<long long>(value));
-  return std::to_string(value);
+  std::ostringstream text;
+  text << value;
+  return text.str();
 }
 
 // Reads one value at a time from the body, in either encoding, with a `where`

@@ -133,7 +133,7 @@ TEST_CASE("point tables need 6 columns x y z nx ny nz", "[io][mesh_io]") {
   check_rejects(dir, "five.xyz", "0 0 0 0 1 0\n0 0 0 0 1\n", "line 2: expected 6 numbers");
   check_rejects(dir, "word.xyz", "0 0 zero 0 1 0\n", "line 1: column 3 'zero'");
   check_rejects(dir, "zero.xyz", "0 0 0 0 0 0\n", "normal of point 0: has zero length");
-  check_rejects(dir, "comments.xyz", "# nothing\n", "no vertices");
+  check_rejects(dir, "comments.xyz", "# nothing\n", "no points");
 }
 
 TEST_CASE("files that are not shapes are rejected naming the file", "[io][mesh_io]") {
