@@ -48,24 +48,6 @@ void Atlas<T>::initialize(Rng& rng) {
   }
 }
 
-template <class T>
-void Atlas<T>::mirror_domain(std::vector<T>& flat) const {
-  JSA_CHECK(flat.size() == params.size(), "mirror_domain: buffer does not match the parameters");
-  auto view = [&](const char* name) {
-    const auto& e = params.entry(params.find(name));
-    return Eigen::Map<Block<T>>(flat.data() + e.offset, e.rows, e.cols);
-  };
-  auto mu = view("domain.mu");  // K x 2: swap u and v
-  mu.col(0).swap(mu.col(1));
-  auto w0 = view("phi.w0");  // 2 x width: the input rows of u and v
-  w0.row(0).swap(w0.row(1));
-  const std::string last = std::to_string(options_.hidden_layers);
-  auto wl = view(("psi.w" + last).c_str());  // width x 2: the output columns
-  wl.col(0).swap(wl.col(1));
-  auto bl = view(("psi.b" + last).c_str());
-  bl.col(0).swap(bl.col(1));
-}
-
 template class Atlas<float>;
 template class Atlas<double>;
 

@@ -29,13 +29,6 @@ class Atlas {
 
   void initialize(Rng& rng);  // mu ~ U[0,1]^2, MLPs as PyTorch's default, codes ~ N(0, 0.01^2)
 
-  // Mirrors the domain, (u, v) -> (v, u), without changing any surface point:
-  // mu's columns swap, phi's first layer takes its inputs swapped, psi's last
-  // layer emits them swapped. J_u and J_v trade places, so every normal of
-  // Eq. 2 flips sign. Applied to a flat buffer laid out like `params` (values,
-  // or Adam's moments).
-  void mirror_domain(std::vector<T>& flat) const;
-
   bool has_codes() const { return options_.shapes > 1; }
   int shapes() const { return options_.shapes; }
   // f_phi,i and f_psi,i (1 x D) of shape i on the tape; invalid Vars for a single shape.

@@ -70,7 +70,6 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["repulsion_tolerance"] = o.repulsion_tolerance;
   j["max_faults"] = o.max_faults;
   j["pool"] = o.pool;
-  j["orient_at"] = o.orient_at;
   j["threads"] = o.threads;
   return j.dump(indent);
 }
@@ -124,7 +123,6 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   field(j, "", "repulsion_tolerance", o.repulsion_tolerance);
   field(j, "", "max_faults", o.max_faults);
   field(j, "", "pool", o.pool);
-  field(j, "", "orient_at", o.orient_at);
   field(j, "", "threads", o.threads);
   if (o.atlas.gaussians <= 0 || o.atlas.width <= 0 || o.atlas.hidden_layers < 0 || o.points <= 0 ||
       o.atlas.shapes <= 0 || o.atlas.code_size <= 0 || o.pool <= 0 || o.threads < 0 || !(o.lr > 0) ||

@@ -1,7 +1,5 @@
 #include "model/trainer.h"
 
-#include "losses/nearest.h"
-
 #include <array>
 #include <cmath>
 #include <istream>
@@ -42,43 +40,7 @@ void Trainer::take_snapshot() {
   good_steps_ = adam_.steps();
 }
 
-// Eq. 2 fixes the normal's side by the order of (u, v): a parametrization that
-// starts mirrored produces inward normals, and the 6D Chamfer, which sees the
-// normals at alpha = 0.01, cannot turn it over without folding the surface
-// (observed on ant_1: 75% of the normals inverted after 1500 iterations). So
-// once, early, compare phi's normals with those of the nearest targets, and if
-// most disagree, mirror the domain (Atlas::mirror_domain): same surface, outward
-// normals. Deterministic, and part of the parameters, so resuming is unaffected.
-void Trainer::orient() {
-  Tape<float> t;
-  Rng rng(options_.seed, 30);
-  double agreement = 0;
-  for (size_t i = 0; i < pools_.size(); ++i) {
-    Var x = atlas_->domain.sample(t, atlas_->params, 2000, rng);
-    SurfacePoints s = atlas_->phi.evaluate(t, atlas_->params, x, true, atlas_->phi_code(t, int(i)));
-    const Block<float> points = t.value(s.points);
-    const Block<float> normals = t.value(s.normals);
-    std::vector<int> nn;
-    const Block<float> pool_points = pools_[i].leftCols(3);
-    nearest(points, pool_points, nn);
-    for (Index k = 0; k < points.rows(); ++k)
-      agreement += double(normals.row(k).dot(pools_[i].row(nn[size_t(k)]).rightCols(3)));
-  }
-  if (agreement < 0) {
-    atlas_->mirror_domain(atlas_->params.values());
-    if (!adam_.first_moment().empty()) {
-      atlas_->mirror_domain(adam_.first_moment());
-      atlas_->mirror_domain(adam_.second_moment());
-    }
-    ++mirrored_;
-  }
-}
-
 void Trainer::step() {
-  if (iteration_ == options_.orient_at && oriented_at_ != iteration_ && options_.components.normals) {
-    orient();
-    oriented_at_ = iteration_;
-  }
   // M targets {x_S, n_S} per shape, drawn with replacement from its pool.
   for (size_t i = 0; i < pools_.size(); ++i)
     for (Index m = 0; m < options_.points; ++m)

@@ -37,7 +37,6 @@ struct FitOptions {
   double repulsion_tolerance = 1e-7;  // cut-off error bound of L_rep
   int max_faults = 5;          // NaN/Inf recoveries in a row before giving up
   Index pool = 200000;         // surface samples drawn once per shape (the targets' pool)
-  int64_t orient_at = 50;      // at this iteration, mirror the domain if phi's normals face inwards (-1: never)
   int threads = 0;             // threads of the run (0: all); results depend on seed and threads
 };
 
@@ -76,7 +75,6 @@ class Trainer {
   void step();
   double learning_rate() const;  // the schedule at the current iteration, times the fault scale
   int faults() const { return faults_total_; }
-  int mirrored() const { return mirrored_; }  // times the domain was mirrored to orient the normals
   // Test hook: the next `count` attempts at `iteration` see a NaN loss.
   void inject_faults(int64_t iteration, int count) {
     fault_at_ = iteration;
@@ -112,11 +110,8 @@ class Trainer {
   double lr_scale_ = 1.0;
   int faults_in_a_row_ = 0, faults_total_ = 0;
   int64_t fault_at_ = -1;
-  int64_t oriented_at_ = -1;
-  int mirrored_ = 0;
   int faults_to_inject_ = 0;
   void take_snapshot();
-  void orient();
 };
 
 }  // namespace jsa
