@@ -35,7 +35,7 @@ std::string write_material(const std::string& obj_path) {
 }
 
 void write_report(const std::string& path, const UvQuality& q, const nlohmann::json& extra) {
-  nlohmann::json j = to_json(q);
+  nlohmann::json j = nlohmann::json::parse(to_json(q));
   for (auto it = extra.begin(); it != extra.end(); ++it) j[it.key()] = it.value();
   write_file_atomically(path, [&](std::ostream& out) { out << j.dump(2) << "\n"; });
 }

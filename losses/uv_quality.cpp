@@ -356,7 +356,7 @@ UvQuality measure_uv_quality(const Block<double>& positions, const Faces& faces,
   return q;
 }
 
-nlohmann::json to_json(const UvQuality& q) {
+std::string to_json(const UvQuality& q, int indent) {
   // NaN has no JSON spelling: a number that was not measured is written as null.
   auto number = [](double v) { return std::isnan(v) ? nlohmann::json() : nlohmann::json(v); };
   nlohmann::json j;
@@ -382,7 +382,7 @@ nlohmann::json to_json(const UvQuality& q) {
   j["seam_length"] = q.seam_length;
   j["charts"] = q.charts;
   j["charts_without_torn"] = q.charts_without_torn;
-  return j;
+  return j.dump(indent);
 }
 
 std::string to_text(const UvQuality& q) {

@@ -62,7 +62,8 @@ UvQuality measure_uv_quality(const Block<double>& positions, const Faces& faces,
                              const Block<double>& uv, const Faces& uv_faces,
                              const UvQualityOptions& options = {});
 
-nlohmann::json to_json(const UvQuality& q);
+// The report as JSON text (unmeasured numbers are null); no JSON type in the API.
+std::string to_json(const UvQuality& q, int indent = 2);
 std::string to_text(const UvQuality& q);  // a two-column table, one quantity per line
 
 }  // namespace jsa

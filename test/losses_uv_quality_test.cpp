@@ -478,7 +478,7 @@ TEST_CASE("uv quality: degenerate triangles are counted and left out", "[uv]") {
 
 TEST_CASE("uv quality: JSON, text and input errors", "[uv]") {
   const UvMesh m = flat_grid(2, 2);
-  const nlohmann::json j = to_json(measure(m));
+  const nlohmann::json j = nlohmann::json::parse(to_json(measure(m)));
   CHECK(j.at("triangles") == 8);
   CHECK(j.at("stretch_l2").get<double>() == Approx(1));
   CHECK(j.at("torn_faces").is_array());
@@ -494,7 +494,7 @@ TEST_CASE("uv quality: JSON, text and input errors", "[uv]") {
     CHECK(q.degenerate == 8);
     CHECK(q.measured == 0);
     CHECK(std::isnan(q.stretch_l2));
-    CHECK(to_json(q).at("stretch_l2").is_null());
+    CHECK(nlohmann::json::parse(to_json(q)).at("stretch_l2").is_null());
     CHECK(q.overlap_ratio == 0);
   }
   SECTION("bad input names the field") {
