@@ -16,30 +16,12 @@
 #include "engine/rng.h"
 #include "io/mesh_io.h"
 
+#include "test/scratch.h"
+
+using test_support::ScratchDir;
+using test_support::message_of;
+
 namespace {
-
-struct ScratchDir {
-  std::string path;
-  ScratchDir() {
-    char pattern[] = "/tmp/jsatlas_io_ply_XXXXXX";
-    path = ::mkdtemp(pattern);
-  }
-  ~ScratchDir() { std::filesystem::remove_all(path); }
-  std::string file(const std::string& name, const std::string& bytes) const {
-    const std::string full = path + "/" + name;
-    std::ofstream(full, std::ios::binary) << bytes;
-    return full;
-  }
-};
-
-std::string message_of(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const jsa::InputError& e) {
-    return e.what();
-  }
-  return "<no InputError thrown>";
-}
 
 // Appends `value` in the given byte order (this test assumes a little-endian host,
 // which it checks below).
