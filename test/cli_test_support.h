@@ -6,6 +6,7 @@
 #include <fstream>
 #include <string>
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace cli_test {
 
@@ -27,9 +28,12 @@ inline Result run(const std::string& args) {
   return r;
 }
 
-// A fresh empty directory under the system temp dir.
+// A fresh empty directory under the system temp dir. The process id keeps test
+// runs from different checkouts on one machine out of each other's way (a shared
+// name failed with "cannot remove: Directory not empty" under concurrent ctest).
 inline std::string fresh_dir(const std::string& name) {
-  const auto d = std::filesystem::temp_directory_path() / ("jsatlas_test_" + name);
+  const auto d = std::filesystem::temp_directory_path() /
+                 ("jsatlas_test_" + name + "_" + std::to_string(::getpid()));
   std::filesystem::remove_all(d);
   std::filesystem::create_directories(d);
   return d.string();
