@@ -47,6 +47,23 @@ void gather_faces(const std::string& path, const tinyobj::ObjReader& reader, Mes
   if (with_normals && mesh.faces.rows() > 0) mesh.normals = normal_sums;
 }
 
+// tinyobjloader 2.0-rc10 converts a `vw` (skin weight) joint id to int without a
+// range check: undefined behaviour for "vw 1 1e18" (UBSan in fuzz_read_obj).
+// Weights do not matter for geometry, so such lines become comments before parsing.
+// Lines end at '\n' or '\r', as tinyobjloader splits them.
+std::string without_skin_weights(std::string text) {
+  for (std::size_t start = 0; start < text.size();) {
+    const std::size_t first = text.find_first_not_of(" \t", start);
+    if (first != std::string::npos && text.compare(first, 2, "vw") == 0 &&
+        first + 2 < text.size() && (text[first + 2] == ' ' || text[first + 2] == '\t'))
+      text[first] = '#';
+    const std::size_t end = text.find_first_of("\r\n", start);
+    if (end == std::string::npos) break;
+    start = end + 1;
+  }
+  return text;
+}
+
 }  // namespace
 
 Mesh read_obj(const std::string& path) {
@@ -57,7 +74,7 @@ Mesh read_obj(const std::string& path) {
   config.vertex_color = false;
   tinyobj::ObjReader reader;
   // Parsing from the string skips `mtllib`: materials do not matter for geometry.
-  if (!reader.ParseFromString(text, "", config) || !reader.Error().empty())
+  if (!reader.ParseFromString(without_skin_weights(text), "", config) || !reader.Error().empty())
     input_error(path, "", "tinyobjloader: " + first_line(reader.Error()));
 
   const tinyobj::attrib_t& attrib = reader.GetAttrib();

@@ -197,3 +197,12 @@ TEST_CASE("fuzz regressions: OBJ normal index past the vn lines, point table wit
   check_rejects(dir, "comments.xyz", "2\n# c2\n# comment\n", "no points");
   check_rejects(dir, "only_comment.xyz", "# nothing\n", "no points");
 }
+
+// Found by fuzz_read_obj in CI: tinyobjloader's int(1e18) on a `vw` joint id (UBSan).
+TEST_CASE("fuzz regressions: OBJ skin-weight lines are ignored", "[io][mesh_io][fuzz]") {
+  ScratchDir dir;
+  const jsa::Mesh mesh = jsa::read_shape(
+      dir.file("weights.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvw 1 0 1e18 0.5\n\tvw 0 1 1\nf 1 2 3\n"));
+  CHECK(mesh.vertices.rows() == 3);
+  CHECK(mesh.faces.rows() == 1);
+}
