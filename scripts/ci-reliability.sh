@@ -64,7 +64,7 @@ run_fuzzer() {
     echo "ci-reliability: $target found a bug; the input is in $artifacts/"
     return 1
   }
-  grep -E "^#[0-9]+ +DONE" "build-fuzz/$target.log" || true
+  grep -E "^#[0-9]+[[:space:]]+DONE" "build-fuzz/$target.log" || true
 }
 
 total_start=$SECONDS
