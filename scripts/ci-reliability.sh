@@ -1,12 +1,17 @@
 #!/usr/bin/env bash
 # Reliability CI (issue 8): (a) the whole test suite under AddressSanitizer +
 # UndefinedBehaviorSanitizer, (b) each libFuzzer target for a bounded time on its
-# seed corpus (test/fuzz/corpus/<target>). Prints how long each step took.
+# seed corpus (test/fuzz/corpus/<target>), deterministically (fixed seed and
+# number of inputs). Prints how long each step took.
 # Builds in build-asan/ and build-fuzz/; installs clang-14 and libclang-rt-14-dev
 # when missing. FUZZ_SECONDS sets the time per target (default 30).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-fuzz_seconds="${FUZZ_SECONDS:-30}"
+fuzz_seconds="${FUZZ_SECONDS:-120}"
+# A fixed seed and a fixed number of inputs: CI replays exactly the inputs that
+# were fuzzed before the commit, so it cannot turn red on a new random find;
+# longer exploratory runs: FUZZ_RUNS=-1 FUZZ_SECONDS=600.
+fuzz_runs="${FUZZ_RUNS:-30000}"
 jobs=2
 
 # "step NAME COMMAND...": runs COMMAND, then prints NAME and its wall time.
@@ -58,7 +63,7 @@ run_fuzzer() {
   local scratch="build-fuzz/corpus/$target" artifacts="build-fuzz/artifacts/$target"
   mkdir -p "$scratch" "$artifacts"
   "build-fuzz/test/fuzz/$target" "$scratch" "test/fuzz/corpus/$target" \
-    -max_total_time="$fuzz_seconds" -timeout=10 -rss_limit_mb=2048 \
+    -seed=1 -runs="$fuzz_runs" -max_total_time="$fuzz_seconds" -timeout=10 -rss_limit_mb=2048 \
     -artifact_prefix="$artifacts/" -print_final_stats=1 > "build-fuzz/$target.log" 2>&1 || {
     tail -n 60 "build-fuzz/$target.log"
     echo "ci-reliability: $target found a bug; the input is in $artifacts/"
@@ -74,6 +79,6 @@ step "clang install check" install_clang
 step "fuzz build" build_fuzz
 for target in fuzz_read_obj fuzz_read_off fuzz_read_ply fuzz_read_xyz fuzz_read_keypoints \
               fuzz_read_checkpoint fuzz_fit_config; do
-  step "$target (${fuzz_seconds} s)" run_fuzzer "$target"
+  step "$target (${fuzz_runs} inputs, seed 1)" run_fuzzer "$target"
 done
 echo "ci-reliability: all steps took $((SECONDS - total_start)) s"
