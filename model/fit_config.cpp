@@ -128,6 +128,12 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
       o.atlas.shapes <= 0 || o.atlas.code_size <= 0 || o.pool <= 0 || o.threads < 0 || !(o.lr > 0) ||
       !std::isfinite(o.lr))
     throw InputError(what + ": sizes must be positive");
+  // The same bounds as the command line's, so a crafted file cannot make the
+  // atlas allocate without limit.
+  if (o.atlas.gaussians > 1000000 || o.atlas.width > 4096 || o.atlas.hidden_layers > 32 ||
+      o.atlas.code_size > 4096 || o.atlas.shapes > 100000 || o.points > 1000000 || o.pool > 10000000 ||
+      o.threads > 1024)
+    throw InputError(what + ": a size is beyond the command line's limits (corrupt settings?)");
   return o;
 }
 

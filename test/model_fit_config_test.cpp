@@ -58,3 +58,16 @@ TEST_CASE("fuzz regressions: integer fields out of their type's range", "[fit_co
   CHECK(message_of(edited("\"gaussians\":", "\"gaussians\":12.0,\"g\":"))
             .empty());  // a whole float is fine
 }
+
+TEST_CASE("fit config: sizes beyond the command line's limits are rejected before anything is allocated",
+          "[fit_config]") {
+  jsa::FitOptions o;
+  o.atlas.width = 1 << 20;
+  const std::string text = jsa::fit_options_to_json(o);
+  try {
+    jsa::fit_options_from_json(text, "settings");
+    FAIL("no InputError");
+  } catch (const jsa::InputError& e) {
+    CHECK(std::string(e.what()).find("beyond the command line's limits") != std::string::npos);
+  }
+}
