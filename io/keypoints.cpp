@@ -1,5 +1,6 @@
 #include "io/keypoints.h"
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -8,6 +9,8 @@
 namespace jsa {
 
 std::vector<int> read_keypoints(const std::string& path, long vertex_count) {
+  // An ifstream opens a directory without complaint and then reads nothing.
+  if (std::filesystem::is_directory(path)) throw InputError(path + ": is a directory, expected a .vts keypoint file");
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open keypoint file");
   std::vector<int> index;
