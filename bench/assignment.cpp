@@ -9,6 +9,7 @@
 // Times n/4, n/2 and n points; per size, the median of R runs of the cost
 // matrix (parallel) and of the LAPJV solve (serial), on the same sets each run
 // (every run must return the same matching).
+#include "bench/timing.h"
 #include "losses/assignment.h"
 
 #include <algorithm>
@@ -30,17 +31,10 @@ namespace {
 
 using jsa::Block;
 using jsa::Index;
-using Clock = std::chrono::steady_clock;
+using bench::Clock;
 
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+using bench::median;
+using bench::seconds_since;
 
 struct Options {
   int threads = 0;  // 0: OpenMP's default

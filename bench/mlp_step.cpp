@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "bench/timing.h"
 #include "engine/ops.h"
 #include "engine/parallel.h"
 #include "engine/parameters.h"
@@ -31,19 +32,12 @@ namespace {
 using jsa::Block;
 using jsa::Index;
 using jsa::Var;
-using Clock = std::chrono::steady_clock;
+using bench::Clock;
 
 const std::vector<int> kWidths = {2, 256, 256, 256, 256, 256, 3};
 
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+using bench::median;
+using bench::seconds_since;
 
 struct Options {
   int threads = 0;  // 0: OpenMP's default
