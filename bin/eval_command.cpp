@@ -42,6 +42,8 @@ void run_eval(const EvalArgs& a) {
   j["chamfer_normal_unit"] = e.fit.chamfer_normal;
   j["floor_chamfer_spatial"] = e.floor.chamfer_spatial;
   j["floor_chamfer_normal_unit"] = e.floor.chamfer_normal;
+  j["back_facing"] = e.fit.back_facing;
+  j["floor_back_facing"] = e.floor.back_facing;
   j["emd_spatial"] = e.fit_emd.spatial;
   j["emd_spatial_squared"] = e.fit_emd.spatial_squared;
   j["emd_normal_unit"] = e.fit_emd.normal;
@@ -56,6 +58,8 @@ void run_eval(const EvalArgs& a) {
               100 * e.floor.chamfer_spatial, e.fit.chamfer_spatial / e.floor.chamfer_spatial);
   std::printf("  Chamfer normal    %6.3f  %6.3f  %5.2f   (unit normals; Table 1 uses alpha = 0.01 x these)\n",
               100 * e.fit.chamfer_normal, 100 * e.floor.chamfer_normal, e.fit.chamfer_normal / e.floor.chamfer_normal);
+  std::printf("  back-facing %%      %6.2f  %6.2f          (Chamfer pairs with n_p . n_q < 0)\n", 100 * e.fit.back_facing,
+              100 * e.floor.back_facing);
   std::printf("  EMD spatial       %6.3f  %6.3f  %5.2f   (exact assignment, %.2f s)\n", 100 * e.fit_emd.spatial,
               100 * e.floor_emd.spatial, e.fit_emd.spatial / e.floor_emd.spatial, e.fit_emd.seconds);
   std::printf("  EMD normal        %6.3f  %6.3f  %5.2f\n", 100 * e.fit_emd.normal, 100 * e.floor_emd.normal,

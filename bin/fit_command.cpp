@@ -154,6 +154,7 @@ void run_fit(FitArgs& a) {
     }
     if (trainer.finished()) continue;
     const int64_t before = trainer.iteration();
+    const int mirrors = trainer.mirrors();
     try {
       trainer.step();
     } catch (const NumericalFault& e) {
@@ -166,6 +167,9 @@ void run_fit(FitArgs& a) {
       continue;
     }
     log.rows.push_back({trainer.iteration(), trainer.learning_rate(), trainer.last()});
+    if (trainer.mirrors() != mirrors && !a.quiet)
+      std::fprintf(stderr, "  it %6lld: most normals faced inward; mirrored the domain (u, v) -> (v, u)\n",
+                   (long long)trainer.iteration());
     const auto now = clock::now();
     const double elapsed = std::chrono::duration<double>(now - start).count();
     if (!a.quiet && (std::chrono::duration<double>(now - last_print).count() > 2.0 || trainer.finished())) {
@@ -229,8 +233,8 @@ void add_fit(CLI::App& app) {
   c->add_option("--threads", a->threads, "Threads (default: all cores; a resumed run keeps its own, as results depend on it)")->check(CLI::Range(0, 1024));
   c->add_option("--w-6d", o.weights.surface, "lambda_6D on L_6D (Eq. 7)")->capture_default_str()->check(CLI::NonNegativeNumber)->check(kFinite);
   c->add_option("--w-2d", o.weights.chart, "lambda_2D on L_2D (Eq. 8)")->capture_default_str()->check(CLI::NonNegativeNumber)->check(kFinite);
-  c->add_option("--w-cycle", o.weights.cycle, "lambda_cycle on L_cycle (Eq. 9->check(kFinite); mean convention, = paper's 1/M on sums)")->capture_default_str()->check(CLI::NonNegativeNumber);
-  c->add_option("--w-iso", o.weights.isometry, "lambda_iso on L_iso (Eq. 10->check(kFinite); mean convention, = paper's 1e-4/M on sums)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  c->add_option("--w-cycle", o.weights.cycle, "lambda_cycle on L_cycle (Eq. 9; mean convention, = paper's 1/M on sums)")->capture_default_str()->check(CLI::NonNegativeNumber)->check(kFinite);
+  c->add_option("--w-iso", o.weights.isometry, "lambda_iso on L_iso (Eq. 10; mean convention, = paper's 1e-4/M on sums)")->capture_default_str()->check(CLI::NonNegativeNumber)->check(kFinite);
   c->add_option("--w-rep", o.weights.repulsion, "lambda_rep on L_rep (Eq. 11)")->capture_default_str()->check(CLI::NonNegativeNumber)->check(kFinite);
   c->add_option("--table-row", a->table_row, "Ablation of the paper's Table 1: row 6..11 (11 = full method)")->check(CLI::Range(6, 11));
   c->add_flag("--no-normals", a->no_normals, "Ablation: 3D Chamfer without normals");
@@ -241,6 +245,7 @@ void add_fit(CLI::App& app) {
   c->add_option("--preset", a->preset, "paper: M = K = 10^4, 5 x 256 MLPs (slow on a laptop)");
   c->add_option("--pool", o.pool, "Surface samples drawn once from the input")->capture_default_str()->check(CLI::Range(Index(100), Index(10000000)));
   c->add_option("--repulsion-tolerance", o.repulsion_tolerance, "Bound on the error of L_rep from its cut-off radius")->capture_default_str()->check(CLI::Range(1e-15, 1e-2))->check(kFinite);
+  c->add_option("--orient-every", o.orient_every, "Choose phi's global orientation every N iterations until the first decay (0: never; see model/orientation.h)")->capture_default_str()->check(CLI::NonNegativeNumber);
   c->add_option("--checkpoint-every", a->checkpoint_every, "Write model.ckpt every N iterations (0: only at the end)")->capture_default_str()->check(CLI::NonNegativeNumber);
   c->add_option("--mesh-resolution", a->mesh_resolution, "Grid cells across the domain for domain_mesh.obj")->capture_default_str()->check(CLI::Range(8, 4096));
   c->add_option("--mesh-threshold", a->mesh_threshold, "Domain = {P >= t * median of P at the means}")->capture_default_str()->check(CLI::Range(0.0, 100.0))->check(kFinite);

@@ -1,10 +1,13 @@
 #include "model/trainer.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <istream>
 #include <limits>
 #include <ostream>
+
+#include "model/orientation.h"
 
 namespace jsa {
 
@@ -76,6 +79,23 @@ void Trainer::step() {
   if (iteration_ % kSnapshotEvery == 0) take_snapshot();
   adam_.step(atlas_->params, learning_rate());
   ++iteration_;
+  choose_orientation();
+}
+
+void Trainer::choose_orientation() {
+  const int every = options_.orient_every;
+  if (every <= 0 || !options_.components.normals || iteration_ % every != 0) return;
+  const double first_decay = options_.decay_at.empty() ? 1.0 : options_.decay_at.front();
+  if (double(iteration_) >= first_decay * double(options_.iterations)) return;
+  // Its own stream: the check does not shift the draws of the training steps.
+  Rng rng(options_.seed, 1000 + uint64_t(iteration_ / every));
+  double back = 0;
+  for (size_t i = 0; i < targets_.size(); ++i)
+    back += back_facing_fraction(*atlas_, targets_[i], std::min<Index>(options_.points, 2000), rng, int(i));
+  if (back / double(targets_.size()) <= 0.5) return;
+  mirror_domain(*atlas_, {&adam_.first_moment(), &adam_.second_moment()});
+  ++mirrors_;
+  take_snapshot();  // a fault must not restore the unmirrored state
 }
 
 // Layout: i64 iteration, 4 x u64 RNG state, i64 Adam steps, f64 lr scale, parameters,

@@ -38,6 +38,9 @@ struct FitOptions {
   int max_faults = 5;          // NaN/Inf recoveries in a row before giving up
   Index pool = 200000;         // surface samples drawn once per shape (the targets' pool)
   int threads = 0;             // threads of the run (0: all); results depend on seed and threads
+  // Every this many iterations before the first decay point, choose the global
+  // orientation of phi (model/orientation.h); 0: never. Only with normals in the loss.
+  int orient_every = 100;
 };
 
 // The paper's configuration (Sec. 3, implementation details).
@@ -75,6 +78,7 @@ class Trainer {
   void step();
   double learning_rate() const;  // the schedule at the current iteration, times the fault scale
   int faults() const { return faults_total_; }
+  int mirrors() const { return mirrors_; }  // times the domain was mirrored (model/orientation.h)
   // Test hook: the next `count` attempts at `iteration` see a NaN loss.
   void inject_faults(int64_t iteration, int count) {
     fault_at_ = iteration;
@@ -111,7 +115,9 @@ class Trainer {
   int faults_in_a_row_ = 0, faults_total_ = 0;
   int64_t fault_at_ = -1;
   int faults_to_inject_ = 0;
+  int mirrors_ = 0;
   void take_snapshot();
+  void choose_orientation();
 };
 
 }  // namespace jsa
