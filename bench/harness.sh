@@ -34,6 +34,7 @@ blas_dir=/usr/lib/x86_64-linux-gnu/openblas-openmp
 # The peer's process environment: the OpenMP build of OpenBLAS, its own kernel choice.
 peer_env=(env -u OPENBLAS_CORETYPE -u OPENBLAS_L2_SIZE "LD_LIBRARY_PATH=$blas_dir" "OMP_NUM_THREADS=$threads")
 
+load_start="$(cut -d' ' -f1-3 /proc/loadavg)"
 mkdir -p "$out"
 out="$(cd "$out" && pwd)"
 rm -f "$out/iteration.csv" "$out/peer_torch.json" "$out/peer_scipy.json"
@@ -118,7 +119,7 @@ build_type="$(sed -n 's/^CMAKE_BUILD_TYPE:STRING=//p' "$b/CMakeCache.txt" 2>/dev
   echo "Command: \`bench/harness.sh $1\`$( [ "${SCALING:-0}" = 1 ] && echo ' with SCALING=1')"
   echo
   echo "Machine: $cpu, $(nproc) cores, $(awk '/MemTotal/ { printf "%.0f GiB", $2 / 1048576 }' /proc/meminfo);" \
-       "$(date -u '+%Y-%m-%d %H:%M UTC'); load average at the end $(cut -d' ' -f1-3 /proc/loadavg) (should be near 0 before the run);" \
+       "$(date -u '+%Y-%m-%d %H:%M UTC'); load average before the run $load_start (near 0 on a quiet machine);" \
        "commit $commit; build ${build_type:-?}; $threads threads;" \
        "medians of $runs runs (C++, SciPy), of $iters iterations after $warmup (torch)."
   echo

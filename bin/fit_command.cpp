@@ -16,6 +16,7 @@
 #include "bin/run_files.h"
 #include "engine/parallel.h"
 #include "io/atomic_write.h"
+#include "io/image.h"
 #include "model/checkpoint.h"
 #include "model/fit_config.h"
 
@@ -37,6 +38,7 @@ struct FitArgs {
   std::string preset;
   int mesh_resolution = 256;
   double mesh_threshold = 0.05;
+  std::string texture;
   double minutes = 0;  // > 0: size --iters to this wall-time budget
   bool quiet = false;
 };
@@ -90,6 +92,7 @@ void run_fit(FitArgs& a) {
   }
   if (a.threads >= 0) o.threads = a.threads;
   set_threads(o.threads);
+  if (!a.texture.empty()) (void)read_image(a.texture);  // a bad texture fails now, not after training
 
   // Each shape, a fixed pool of surface samples, and its unit frame (Sec. 4 data).
   std::vector<RunInput> shapes;
@@ -190,7 +193,7 @@ void run_fit(FitArgs& a) {
     }
   }
   save();
-  write_run_outputs(trainer.atlas(), shapes, log, dir, MeshOutputOptions{a.mesh_resolution, a.mesh_threshold, a.quiet});
+  write_run_outputs(trainer.atlas(), shapes, log, dir, MeshOutputOptions{a.mesh_resolution, a.mesh_threshold, a.quiet, a.texture});
   if (!a.quiet)
     std::cerr << "fit: done in " << format_duration(std::chrono::duration<double>(clock::now() - start).count())
               << "; results in " << dir << "\n";
@@ -245,10 +248,12 @@ void add_fit(CLI::App& app) {
   c->add_option("--preset", a->preset, "paper: M = K = 10^4, 5 x 256 MLPs (slow on a laptop)");
   c->add_option("--pool", o.pool, "Surface samples drawn once from the input")->capture_default_str()->check(CLI::Range(Index(100), Index(10000000)));
   c->add_option("--repulsion-tolerance", o.repulsion_tolerance, "Bound on the error of L_rep from its cut-off radius")->capture_default_str()->check(CLI::Range(1e-15, 1e-2))->check(kFinite);
+  c->add_option("--batch-shapes", o.batch_shapes, "Collections: shapes per iteration, a seeded random subset (0: all); the loss is scaled by N/B")->capture_default_str()->check(CLI::NonNegativeNumber);
   c->add_option("--orient-every", o.orient_every, "Choose phi's global orientation every N iterations until the first decay (0: never; see model/orientation.h)")->capture_default_str()->check(CLI::NonNegativeNumber);
   c->add_option("--checkpoint-every", a->checkpoint_every, "Write model.ckpt every N iterations (0: only at the end)")->capture_default_str()->check(CLI::NonNegativeNumber);
   c->add_option("--mesh-resolution", a->mesh_resolution, "Grid cells across the domain for domain_mesh.obj")->capture_default_str()->check(CLI::Range(8, 4096));
   c->add_option("--mesh-threshold", a->mesh_threshold, "Domain = {P >= t * median of P at the means}")->capture_default_str()->check(CLI::Range(0.0, 100.0))->check(kFinite);
+  c->add_option("--texture", a->texture, "An image for the MTLs of the results; also writes texture_transfer.png");
   c->add_flag("-q,--quiet", a->quiet, "No progress output");
   c->callback([a]() { run_fit(*a); });
 }

@@ -54,6 +54,7 @@ void add_mesh(CLI::App& app) {
   c->add_option("--threshold", a->options.threshold, "Domain = {P >= t * median of P at the means}")->capture_default_str()->check(CLI::Range(0.0, 100.0));
   c->add_option("--threads", a->threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
   c->add_option("--shape", a->shape, "Which shape of a collection (0-based)")->capture_default_str();
+  c->add_option("--texture", a->options.texture, "An image for the MTL instead of the built-in colour chart (a texture made for one shape of a collection fits every shape)");
   c->add_flag("-q,--quiet", a->options.quiet, "No report on the terminal");
   c->callback([a]() {
     set_threads(a->threads);
@@ -73,6 +74,7 @@ void add_chart(CLI::App& app) {
   c->add_option("--torn-ratio", a->options.torn_ratio, "A UV edge this many times longer than its 3D edge (areas equalised) is torn")->capture_default_str()->check(CLI::Range(1.0, 1e6));
   c->add_option("--threads", a->threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
   c->add_option("--shape", a->shape, "Which shape of a collection (0-based)")->capture_default_str();
+  c->add_option("--texture", a->options.texture, "An image for the MTL instead of the built-in colour chart (a texture made for one shape of a collection fits every shape)");
   c->add_flag("-q,--quiet", a->options.quiet, "No report on the terminal");
   c->callback([a]() {
     set_threads(a->threads);

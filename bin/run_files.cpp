@@ -23,12 +23,19 @@ std::string stem_of(const std::string& obj_path) {
   return (p.parent_path() / p.stem()).string();
 }
 
-// OUT.mtl and the shared texture next to OUT.obj; returns the MTL's file name.
-std::string write_material(const std::string& obj_path) {
+// OUT.mtl and its texture next to OUT.obj: the built-in colour chart, or the
+// user's image (`user_texture`) re-encoded as PNG, so the directory is
+// self-contained. Returns the MTL's file name.
+std::string write_material(const std::string& obj_path, const std::string& user_texture) {
   const fs::path p(obj_path);
-  const std::string texture = "jsatlas_texture.png";
   const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
-  write_png((dir / texture).string(), colour_chart(1024));
+  std::string texture = "jsatlas_texture.png";
+  if (user_texture.empty()) {
+    write_png((dir / texture).string(), colour_chart(1024));
+  } else {
+    texture = fs::path(user_texture).stem().string() + "_texture.png";
+    write_png((dir / texture).string(), read_image(user_texture));
+  }
   const std::string mtl = p.stem().string() + ".mtl";
   write_mtl((dir / mtl).string(), "atlas", texture);
   return mtl;
@@ -56,7 +63,7 @@ void write_domain_mesh(Atlas<float>& atlas, const Normalization& normalization,
   out.normals = normals;
   out.faces = dm.faces;
   const Block<double> vt = texture_frame(atlas).to_texture(dm.uv);
-  write_obj(obj_path, out, &vt, write_material(obj_path), "atlas");
+  write_obj(obj_path, out, &vt, write_material(obj_path, o.texture), "atlas");
   const std::string stem = stem_of(obj_path);
   const UvQuality q = measure_uv_quality(out.vertices, out.faces, vt, out.faces);
   write_report(stem + "_uv.json", q, {{"domain_mass_fraction", dm.mass_fraction}, {"threshold", o.threshold},
@@ -86,7 +93,7 @@ void write_chart(Atlas<float>& atlas, const Normalization& normalization, const 
     uv_faces = split.uv_faces;
     q = measure_uv_quality(mesh.vertices, mesh.faces, vt, uv_faces, qo);
   }
-  write_obj(obj_path, mesh, &vt, write_material(obj_path), "atlas", o.split_cuts ? &uv_faces : nullptr);
+  write_obj(obj_path, mesh, &vt, write_material(obj_path, o.texture), "atlas", o.split_cuts ? &uv_faces : nullptr);
   const std::string stem = stem_of(obj_path);
   write_report(stem + "_uv.json", q, {{"map", "input mesh -> psi (2D); measured as uv -> 3D"},
                                       {"split_cuts", o.split_cuts}, {"torn_before_split", torn_before}});
@@ -105,7 +112,9 @@ void write_chart(Atlas<float>& atlas, const Normalization& normalization, const 
 void write_run_outputs(Atlas<float>& atlas, const std::vector<RunInput>& inputs, const LossLog& log,
                        const std::string& dir, const MeshOutputOptions& mesh) {
   const bool collection = inputs.size() > 1;
-  std::vector<Image> coloured;
+  // Read once up front: a bad texture fails before anything is written.
+  const Image texture = mesh.texture.empty() ? Image() : read_image(mesh.texture);
+  std::vector<Image> coloured, textured;
   std::vector<std::string> captions;
   for (size_t i = 0; i < inputs.size(); ++i) {
     const std::string sub = collection ? dir + "/shape_" + std::to_string(i) : dir;
@@ -117,15 +126,16 @@ void write_run_outputs(Atlas<float>& atlas, const std::vector<RunInput>& inputs,
     if (inputs[i].mesh.faces.rows() > 0) {
       ChartOutputOptions co;
       co.quiet = mesh.quiet;
+      co.texture = mesh.texture;
       write_chart(atlas, inputs[i].normalization, inputs[i].mesh, sub + "/input_chart.obj", co, int(i));
-      if (collection) {
-        // One view per shape, coloured by its position in the shared domain.
-        const Mesh& m = inputs[i].mesh;
-        const Block<double> vt =
-            texture_frame(atlas).to_texture(chart_vertices(atlas, m, inputs[i].normalization, int(i)));
-        coloured.push_back(domain_coloured_views(m.vertices, m.faces, vt, 320));
-        captions.push_back("shape " + std::to_string(i));
-      }
+      // One view per shape, coloured by its position in the shared domain
+      // (and, with a texture, textured through its chart).
+      const Mesh& m = inputs[i].mesh;
+      const Block<double> vt =
+          texture_frame(atlas).to_texture(chart_vertices(atlas, m, inputs[i].normalization, int(i)));
+      if (collection) coloured.push_back(domain_coloured_views(m.vertices, m.faces, vt, 320));
+      if (texture.width > 0) textured.push_back(textured_views(m.vertices, m.faces, vt, texture, 320));
+      captions.push_back("shape " + std::to_string(i));
     }
   }
   if (collection && !coloured.empty()) {
@@ -133,6 +143,12 @@ void write_run_outputs(Atlas<float>& atlas, const std::vector<RunInput>& inputs,
     g.columns = 1;
     g.captions = captions;
     write_png(dir + "/collection.png", compose_grid(coloured, g));
+  }
+  if (!textured.empty()) {
+    GridOptions g;
+    g.columns = 1;
+    g.captions = captions;
+    write_png(dir + "/texture_transfer.png", compose_grid(textured, g));
   }
   const DomainMesh dm = mesh_domain(atlas, DomainMeshOptions{64, mesh.threshold});
   write_png(dir + "/domain.png", domain_picture(atlas, dm.level));

@@ -3,6 +3,7 @@
 // which anti-aliases edges without any special cases.
 #include "io/image.h"
 
+#include <stb/stb_image.h>
 #include <stb/stb_image_write.h>
 
 #include <algorithm>
@@ -71,6 +72,29 @@ void Image::paste(const Image& source, int x, int y) {
         const std::size_t to = (static_cast<std::size_t>(y + sy) * width + (x + sx)) * 3;
         std::copy(&source.rgb[from], &source.rgb[from] + 3, &rgb[to]);
       }
+}
+
+Image read_image(const std::string& path) {
+  int width = 0, height = 0, channels = 0;
+  if (!stbi_info(path.c_str(), &width, &height, &channels)) {
+    const char* why = stbi_failure_reason();
+    throw InputError(path + ": not a readable image (" + (why ? why : "unknown reason") + ")");
+  }
+  constexpr int kMaxSide = 16384;
+  if (width <= 0 || height <= 0 || width > kMaxSide || height > kMaxSide)
+    throw InputError(path + ": image of " + std::to_string(width) + " x " + std::to_string(height) +
+                     " pixels (at most " + std::to_string(kMaxSide) + " a side)");
+  unsigned char* data = stbi_load(path.c_str(), &width, &height, &channels, 3);
+  if (!data) {
+    const char* why = stbi_failure_reason();
+    throw InputError(path + ": cannot decode the image (" + (why ? why : "unknown reason") + ")");
+  }
+  Image image;
+  image.width = width;
+  image.height = height;
+  image.rgb.assign(data, data + static_cast<std::size_t>(width) * height * 3);
+  stbi_image_free(data);
+  return image;
 }
 
 void write_png(const std::string& path, const Image& image) {

@@ -40,6 +40,11 @@ struct Image {
   void paste(const Image& source, int x, int y);
 };
 
+// Decodes an image file (PNG, JPEG, BMP, TGA: whatever stb_image reads) to RGB.
+// Throws InputError with the reason if it is missing, unreadable, not an image,
+// or larger than 16384 x 16384 (checked from the header, before decoding).
+Image read_image(const std::string& path);
+
 // Encodes a PNG with stb_image_write and writes it through write_file_atomically.
 // Throws InputError if the directory is missing or not writable.
 void write_png(const std::string& path, const Image& image);

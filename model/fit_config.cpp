@@ -70,6 +70,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["repulsion_tolerance"] = o.repulsion_tolerance;
   j["max_faults"] = o.max_faults;
   j["orient_every"] = o.orient_every;
+  j["batch_shapes"] = o.batch_shapes;
   j["pool"] = o.pool;
   j["threads"] = o.threads;
   return j.dump(indent);
@@ -123,11 +124,15 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   field(j, "", "seed", o.seed);
   field(j, "", "repulsion_tolerance", o.repulsion_tolerance);
   field(j, "", "max_faults", o.max_faults);
-  field(j, "", "orient_every", o.orient_every);
+  // Added after the first checkpoints were written: a file without them comes
+  // from a run that had neither, so absent means 0 (what that run did).
+  o.orient_every = 0;
+  if (j.contains("orient_every")) field(j, "", "orient_every", o.orient_every);
+  if (j.contains("batch_shapes")) field(j, "", "batch_shapes", o.batch_shapes);
   field(j, "", "pool", o.pool);
   field(j, "", "threads", o.threads);
   if (o.atlas.gaussians <= 0 || o.atlas.width <= 0 || o.atlas.hidden_layers < 0 || o.points <= 0 ||
-      o.atlas.shapes <= 0 || o.atlas.code_size <= 0 || o.pool <= 0 || o.threads < 0 || o.orient_every < 0 || !(o.lr > 0) ||
+      o.atlas.shapes <= 0 || o.atlas.code_size <= 0 || o.pool <= 0 || o.threads < 0 || o.orient_every < 0 || o.batch_shapes < 0 || !(o.lr > 0) ||
       !std::isfinite(o.lr))
     throw InputError(what + ": sizes must be positive");
   // The same bounds as the command line's, so a crafted file cannot make the

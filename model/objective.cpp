@@ -100,22 +100,29 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
 
 template <class T>
 Var collection_objective(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>>& targets, Index m,
-                         Rng& rng, const ObjectiveOptions& o, LossTerms* terms) {
-  const int n = int(targets.size());
-  JSA_CHECK(n == atlas.shapes(), targets.size() << " target sets for " << atlas.shapes() << " shapes");
+                         Rng& rng, const ObjectiveOptions& o, LossTerms* terms, const std::vector<int>& batch) {
+  const int n = atlas.shapes();
+  const int b = int(targets.size());
+  if (batch.empty())
+    JSA_CHECK(b == n, targets.size() << " target sets for " << n << " shapes");
+  else
+    JSA_CHECK(b == int(batch.size()) && b > 0 && b <= n, targets.size() << " target sets for a batch of " << batch.size());
   ObjectiveOptions per_shape = o;
   per_shape.components.repulsion = false;
   LossTerms sum_terms, one;
   Var total;
-  for (int i = 0; i < n; ++i) {
-    const Var l = single_shape_objective(t, atlas, i, targets[size_t(i)], m, rng, per_shape, &one);
-    total = i == 0 ? l : add(t, total, l);
-    sum_terms.surface += one.surface / n;
-    sum_terms.chart += one.chart / n;
-    sum_terms.cycle_2d += one.cycle_2d / n;
-    sum_terms.cycle_6d += one.cycle_6d / n;
-    sum_terms.isometry += one.isometry / n;
+  for (int k = 0; k < b; ++k) {
+    const int shape = batch.empty() ? k : batch[size_t(k)];
+    JSA_CHECK(shape >= 0 && shape < n, "shape " << shape << " of " << n);
+    const Var l = single_shape_objective(t, atlas, shape, targets[size_t(k)], m, rng, per_shape, &one);
+    total = k == 0 ? l : add(t, total, l);
+    sum_terms.surface += one.surface / b;
+    sum_terms.chart += one.chart / b;
+    sum_terms.cycle_2d += one.cycle_2d / b;
+    sum_terms.cycle_6d += one.cycle_6d / b;
+    sum_terms.isometry += one.isometry / b;
   }
+  if (b < n) total = scale(t, total, T(double(n) / double(b)));
   if (!std::isfinite(sum_terms.surface) || !atlas.params.value(atlas.domain.means()).allFinite()) {
     // A diverged step (see single_shape_objective): NaN for the trainer to catch.
     sum_terms.total = std::numeric_limits<double>::quiet_NaN();
@@ -144,7 +151,8 @@ Var collection_objective(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>
   template Var single_shape_objective<T>(Tape<T>&, Atlas<T>&, int, const Block<T>&, Index, Rng&, \
                                          const ObjectiveOptions&, LossTerms*);                   \
   template Var collection_objective<T>(Tape<T>&, Atlas<T>&, const std::vector<Block<T>>&, Index, \
-                                       Rng&, const ObjectiveOptions&, LossTerms*);
+                                       Rng&, const ObjectiveOptions&, LossTerms*,              \
+                                       const std::vector<int>&);
 JSA_INSTANTIATE(float)
 JSA_INSTANTIATE(double)
 

@@ -55,8 +55,12 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
 // so it is computed once and counted N times (as the sum does); a collection
 // adds l_code * mean |f|^2 over its codes (the auto-decoder's prior). terms
 // receives the per-shape terms averaged over the shapes.
+// batch: the shapes targets[b] belong to, when a step uses a subset of B of the
+// N shapes (empty: all, in order). The subset's sum is scaled by N / B, so that
+// over a uniformly drawn subset its expectation is the full sum of Eq. (12).
 template <class T>
 Var collection_objective(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>>& targets,
-                         Index samples, Rng& rng, const ObjectiveOptions& o, LossTerms* terms);
+                         Index samples, Rng& rng, const ObjectiveOptions& o, LossTerms* terms,
+                         const std::vector<int>& batch = {});
 
 }  // namespace jsa

@@ -74,6 +74,16 @@ Image domain_coloured_views(const Block<double>& vertices, const Faces& faces,
   return side_by_side(views);
 }
 
+Image textured_views(const Block<double>& vertices, const Faces& faces, const Block<double>& texture_uv,
+                     const Image& texture, int size) {
+  RenderOptions ro;
+  ro.width = ro.height = size;
+  std::vector<Image> views;
+  for (const Camera& c : three_views(vertices))
+    views.push_back(render_textured_mesh(vertices, faces, texture_uv, texture, c, ro));
+  return side_by_side(views);
+}
+
 Image uv_layout_picture(const Block<double>& vertices, const Faces& faces, const Block<double>& texture_uv,
                         const Faces& uv_faces, const std::vector<int>& flipped, const std::vector<int>& torn,
                         int size) {

@@ -21,6 +21,10 @@ Image loss_curves(const LossLog& log);
 // texture_uv: V x 2 in [0,1]^2 (TextureFrame coordinates) giving each vertex its colour.
 Image domain_coloured_views(const Block<double>& vertices, const Faces& faces,
                             const Block<double>& texture_uv, int size = 384);
+// The same three views with each pixel coloured from `texture` at its
+// interpolated uv (V x 2, TextureFrame coordinates): texture transfer made visible.
+Image textured_views(const Block<double>& vertices, const Faces& faces, const Block<double>& texture_uv,
+                     const Image& texture, int size = 384);
 // flipped faces are outlined in red; torn faces (which span the cut, across the
 // whole layout) are left unfilled and marked by red dots at their corners.
 Image uv_layout_picture(const Block<double>& vertices, const Faces& faces,

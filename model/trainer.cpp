@@ -20,8 +20,12 @@ Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools)
     JSA_CHECK(pool.cols() == 6 && pool.rows() > 0, "a target pool must be P x 6");
     pools_.push_back(pool.cast<float>());
     pools_.back().rightCols(3) *= float(o.atlas.alpha);
-    targets_.emplace_back(o.points, 6);
   }
+  const int n = int(pools.size());
+  const int b = o.batch_shapes > 0 && o.batch_shapes < n ? o.batch_shapes : n;
+  if (o.batch_shapes < 0) throw InputError("--batch-shapes must be >= 0");
+  targets_.assign(size_t(b), Block<float>(o.points, 6));
+  for (int i = 0; i < b; ++i) batch_.push_back(i);
   options_.atlas.shapes = int(pools.size());
   AtlasOptions ao = options_.atlas;
   ao.gaussian_noise = o.components.distribution;
@@ -44,13 +48,23 @@ void Trainer::take_snapshot() {
 }
 
 void Trainer::step() {
-  // M targets {x_S, n_S} per shape, drawn with replacement from its pool.
-  for (size_t i = 0; i < pools_.size(); ++i)
-    for (Index m = 0; m < options_.points; ++m)
-      targets_[i].row(m) = pools_[i].row(Index(rng_.below(uint64_t(pools_[i].rows()))));
+  const int n = int(pools_.size()), b = int(batch_.size());
+  if (b < n) {
+    // A uniform subset of B shapes: the first B of a partial Fisher-Yates shuffle.
+    std::vector<int> order(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) order[size_t(i)] = i;
+    for (int i = 0; i < b; ++i) std::swap(order[size_t(i)], order[size_t(i) + rng_.below(uint64_t(n - i))]);
+    batch_.assign(order.begin(), order.begin() + b);
+  }
+  // M targets {x_S, n_S} per shape of the batch, drawn with replacement from its pool.
+  for (int k = 0; k < b; ++k) {
+    const Block<float>& pool = pools_[size_t(batch_[size_t(k)])];
+    for (Index m = 0; m < options_.points; ++m) targets_[size_t(k)].row(m) = pool.row(Index(rng_.below(uint64_t(pool.rows()))));
+  }
   tape_.clear();
   const ObjectiveOptions objective{options_.weights, options_.components, options_.repulsion_tolerance};
-  Var loss = collection_objective(tape_, *atlas_, targets_, options_.points, rng_, objective, &last_);
+  Var loss = collection_objective(tape_, *atlas_, targets_, options_.points, rng_, objective, &last_,
+                                  b < n ? batch_ : std::vector<int>{});
   atlas_->params.zero_grad();
   tape_.backward(loss);
   if (iteration_ == fault_at_ && faults_to_inject_ > 0) {
@@ -91,7 +105,7 @@ void Trainer::choose_orientation() {
   Rng rng(options_.seed, 1000 + uint64_t(iteration_ / every));
   double back = 0;
   for (size_t i = 0; i < targets_.size(); ++i)
-    back += back_facing_fraction(*atlas_, targets_[i], std::min<Index>(options_.points, 2000), rng, int(i));
+    back += back_facing_fraction(*atlas_, targets_[i], std::min<Index>(options_.points, 2000), rng, batch_[i]);
   if (back / double(targets_.size()) <= 0.5) return;
   mirror_domain(*atlas_, {&adam_.first_moment(), &adam_.second_moment()});
   ++mirrors_;

@@ -41,6 +41,9 @@ struct FitOptions {
   // Every this many iterations before the first decay point, choose the global
   // orientation of phi (model/orientation.h); 0: never. Only with normals in the loss.
   int orient_every = 100;
+  // Collections: shapes per step, drawn without replacement from the seeded
+  // stream (0 or >= N: all N). A step costs about B single-shape steps.
+  int batch_shapes = 0;
 };
 
 // The paper's configuration (Sec. 3, implementation details).
@@ -106,7 +109,8 @@ class Trainer {
   Rng rng_;
   int64_t iteration_ = 0;
   LossTerms last_;
-  std::vector<Block<float>> targets_;
+  std::vector<Block<float>> targets_;  // per shape of the step's batch
+  std::vector<int> batch_;             // the shapes of the step (all N without batching)
   // The last good state, refreshed every kSnapshotEvery iterations.
   static constexpr int64_t kSnapshotEvery = 50;
   std::vector<float> good_params_, good_m_, good_v_;

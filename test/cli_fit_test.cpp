@@ -10,6 +10,7 @@
 #include <tiny_obj_loader.h>
 
 #include "io/builtin_shapes.h"
+#include "io/image.h"
 #include "test/cli_test_support.h"
 
 using namespace cli_test;
@@ -118,4 +119,30 @@ TEST_CASE("cli: the chart OBJ reads back in tinyobjloader with one vt per input 
     CHECK(same_order);
     CHECK(uv_in_range);
   }
+}
+
+TEST_CASE("cli: a collection with a shape batch and a user texture writes the texture transfer", "[cli]") {
+  const std::string dir = fresh_dir("texture");
+  const std::string texture = dir + "/../jsatlas_test_paint_" + std::to_string(::getpid()) + ".png";
+  jsa::write_png(texture, jsa::checkerboard(64, 8));
+  Result r = run("fit builtin:sphere builtin:capsule builtin:torus -o " + dir +
+                 " --iters 12 --batch-shapes 2 --code-size 8 --texture " + texture + kSmall);
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  CHECK(read_text(dir + "/config.json").find("\"batch_shapes\": 2") != std::string::npos);
+  CHECK(fs::exists(dir + "/texture_transfer.png"));
+  CHECK(fs::exists(dir + "/collection.png"));
+  const std::string stem = fs::path(texture).stem().string();
+  for (int i = 0; i < 3; ++i) {
+    const std::string sub = dir + "/shape_" + std::to_string(i);
+    CHECK(read_text(sub + "/input_chart.mtl").find(stem + "_texture.png") != std::string::npos);
+    CHECK(jsa::read_image(sub + "/" + stem + "_texture.png").width == 64);
+  }
+  // A texture that cannot be read stops the fit before any training.
+  const std::string other = fresh_dir("texture_bad");
+  r = run("fit builtin:sphere -o " + other + " --iters 5 --texture " + dir + "/config.json" + kSmall);
+  CHECK(r.code == 1);
+  CHECK(r.output.find("config.json: not a readable image") != std::string::npos);
+  CHECK(!fs::exists(other + "/model.ckpt"));
+  fs::remove(texture);
 }

@@ -4,8 +4,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <cstdlib>
 #include <string>
 #include <sys/wait.h>
+#include <vector>
 #include <unistd.h>
 
 namespace cli_test {
@@ -28,6 +30,18 @@ inline Result run(const std::string& args) {
   return r;
 }
 
+// The directories made by fresh_dir, removed when the test program exits
+// (set JSATLAS_KEEP_TEST_DIRS=1 to keep them for a look).
+struct TestDirs {
+  std::vector<std::filesystem::path> made;
+  ~TestDirs() {
+    if (std::getenv("JSATLAS_KEEP_TEST_DIRS")) return;
+    std::error_code ignored;
+    for (const auto& d : made) std::filesystem::remove_all(d, ignored);
+  }
+};
+inline TestDirs test_dirs;
+
 // A fresh empty directory under the system temp dir. The process id keeps test
 // runs from different checkouts on one machine out of each other's way (a shared
 // name failed with "cannot remove: Directory not empty" under concurrent ctest).
@@ -36,6 +50,7 @@ inline std::string fresh_dir(const std::string& name) {
                  ("jsatlas_test_" + name + "_" + std::to_string(::getpid()));
   std::filesystem::remove_all(d);
   std::filesystem::create_directories(d);
+  test_dirs.made.push_back(d);
   return d.string();
 }
 

@@ -72,6 +72,36 @@ TEST_CASE("write_png reports a missing directory as bad input", "[image]") {
   CHECK_THROWS_AS(jsa::write_png("/tmp/empty.png", jsa::Image()), jsa::InternalError);
 }
 
+TEST_CASE("read_image decodes what write_png wrote, and rejects what is not an image", "[image]") {
+  const std::string base = std::filesystem::temp_directory_path() /
+                           ("jsatlas_read_image_" + std::to_string(::getpid()));
+  jsa::Image image(13, 7, jsa::colours::white());
+  image.set(3, 2, {0.2, 0.4, 0.6});
+  image.set(12, 6, {1, 0, 0});
+  jsa::write_png(base + ".png", image);
+  const jsa::Image back = jsa::read_image(base + ".png");
+  CHECK(back.width == 13);
+  CHECK(back.height == 7);
+  CHECK(back.rgb == image.rgb);
+  std::ofstream(base + ".txt") << "not an image at all\n";
+  CHECK_THROWS_AS(jsa::read_image(base + ".txt"), jsa::InputError);
+  CHECK_THROWS_AS(jsa::read_image(base + "_missing.png"), jsa::InputError);
+  std::ofstream(base + "_empty.png").flush();
+  CHECK_THROWS_AS(jsa::read_image(base + "_empty.png"), jsa::InputError);
+  // A PNG header claiming 20000 x 1 pixels is refused from the header, before decoding.
+  std::string bytes = slurp(base + ".png");
+  const unsigned char wide[8] = {0, 0, 0x4E, 0x20, 0, 0, 0, 1};
+  for (int k = 0; k < 8; ++k) bytes[16 + k] = char(wide[k]);
+  std::ofstream(base + "_huge.png", std::ios::binary) << bytes;
+  try {
+    jsa::read_image(base + "_huge.png");
+    FAIL("a 20000 x 1 header was accepted");
+  } catch (const jsa::InputError& e) {
+    CHECK(std::string(e.what()).find("20000 x 1 pixels") != std::string::npos);
+  }
+  for (const char* ext : {".png", ".txt", "_empty.png", "_huge.png"}) std::filesystem::remove(base + ext);
+}
+
 TEST_CASE("pixels: set, get, blend, clipping", "[image]") {
   jsa::Image image(4, 3, jsa::colours::white());
   image.set(1, 2, {0, 0.5, 1});

@@ -34,6 +34,26 @@ TEST_CASE("fit config: the defaults round-trip through JSON", "[fit_config]") {
   CHECK(o.seed == jsa::FitOptions().seed);
 }
 
+TEST_CASE("fit config: settings added later read as what older runs did", "[fit_config]") {
+  jsa::FitOptions o;
+  o.orient_every = 25;
+  o.batch_shapes = 3;
+  const jsa::FitOptions back = jsa::fit_options_from_json(jsa::fit_options_to_json(o), "x");
+  CHECK(back.orient_every == 25);
+  CHECK(back.batch_shapes == 3);
+  // A checkpoint written before these existed: no orientation check, no batching.
+  std::string old = jsa::fit_options_to_json(o, -1);
+  for (const std::string key : {"\"orient_every\":25,", "\"batch_shapes\":3,"}) {
+    const auto at = old.find(key);
+    REQUIRE(at != std::string::npos);
+    old.erase(at, key.size());
+  }
+  const jsa::FitOptions legacy = jsa::fit_options_from_json(old, "old");
+  CHECK(legacy.orient_every == 0);
+  CHECK(legacy.batch_shapes == 0);
+  CHECK(message_of(edited("\"batch_shapes\":0", "\"batch_shapes\":-2")) == "run/model.ckpt: sizes must be positive");
+}
+
 TEST_CASE("fit config: malformed JSON is rejected naming the source and the field",
           "[fit_config]") {
   CHECK(message_of("{\"atlas\": 3").find("run/model.ckpt: not valid JSON") == 0);

@@ -135,3 +135,30 @@ TEST_CASE("objective: ablation rows switch the terms on one by one", "[objective
   CHECK(Components::table_row(11).isometry);
   CHECK_THROWS_AS(Components::table_row(5), InternalError);
 }
+
+TEST_CASE("objective: a batch of B of N shapes is their sum scaled by N / B", "[objective]") {
+  AtlasOptions ao;
+  ao.gaussians = 16;
+  ao.width = 8;
+  ao.hidden_layers = 2;
+  ao.shapes = 3;
+  ao.code_size = 4;
+  Atlas<double> atlas(ao);
+  Rng init(6);
+  atlas.initialize(init);
+  const Block<double> t0 = random_targets(24, ao.alpha, 7), t2 = random_targets(24, ao.alpha, 8);
+  ObjectiveOptions o;
+  o.components.repulsion = false;  // counted once per step, not per shape: compared separately
+  o.weights.code = 0;
+  Tape<double> tape;
+  Rng r1(11);
+  const double batch = tape.scalar(collection_objective(tape, atlas, {t2, t0}, 24, r1, o, nullptr, {2, 0}));
+  tape.clear();
+  Rng r2(11);
+  const double l2 = tape.scalar(single_shape_objective(tape, atlas, 2, t2, 24, r2, o, nullptr));
+  const double l0 = tape.scalar(single_shape_objective(tape, atlas, 0, t0, 24, r2, o, nullptr));
+  CHECK(batch == Approx(1.5 * (l2 + l0)).epsilon(1e-12));
+  tape.clear();
+  Rng r3(11);
+  CHECK_THROWS_AS(collection_objective(tape, atlas, {t2, t0}, 24, r3, o, nullptr, {2, 3}), InternalError);
+}
