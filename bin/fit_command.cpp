@@ -248,6 +248,7 @@ void add_fit(CLI::App& app) {
   c->add_option("--preset", a->preset, "paper: M = K = 10^4, 5 x 256 MLPs (slow on a laptop)");
   c->add_option("--pool", o.pool, "Surface samples drawn once from the input")->capture_default_str()->check(CLI::Range(Index(100), Index(10000000)));
   c->add_option("--repulsion-tolerance", o.repulsion_tolerance, "Bound on the error of L_rep from its cut-off radius")->capture_default_str()->check(CLI::Range(1e-15, 1e-2))->check(kFinite);
+  c->add_option("--code-layer", o.atlas.code_layer, "Collections: where the codes enter phi and psi: 0 the input (concatenation), 1 after the first layer")->capture_default_str()->check(CLI::Range(0, 1));
   c->add_option("--batch-shapes", o.batch_shapes, "Collections: shapes per iteration, a seeded random subset (0: all); the loss is scaled by N/B")->capture_default_str()->check(CLI::NonNegativeNumber);
   c->add_option("--orient-every", o.orient_every, "Choose phi's global orientation every N iterations until the first decay (0: never; see model/orientation.h)")->capture_default_str()->check(CLI::NonNegativeNumber);
   c->add_option("--checkpoint-every", a->checkpoint_every, "Write model.ckpt every N iterations (0: only at the end)")->capture_default_str()->check(CLI::NonNegativeNumber);

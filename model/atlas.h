@@ -18,6 +18,7 @@ struct AtlasOptions {
   bool gaussian_noise = true;  // sample P (true) or the means alone (Table 1 rows 6-8)
   int shapes = 1;           // N shapes sharing the domain (Sec. 3.4); > 1 adds latent codes
   int code_size = 256;      // D, width of f_phi,i and f_psi,i when shapes > 1 (paper: 256)
+  int code_layer = 0;       // where codes enter phi and psi: 0 the input (concatenation), 1 after the first layer
 };
 
 template <class T>

@@ -41,6 +41,17 @@ KeypointError keypoint_error(Atlas<float>& atlas, const std::vector<Mesh>& meshe
                              const std::vector<Normalization>& frames,
                              const std::vector<std::vector<int>>& keypoints, const CorrespondenceOptions& o,
                              const std::vector<double>& thresholds) {
+  const CorrespondenceMap map = [&](int from, int to, const Block<double>& p,
+                                    const Block<double>& n) {
+    return correspond(atlas, from, to, p, n, o);
+  };
+  return keypoint_error(map, meshes, frames, keypoints, thresholds);
+}
+
+KeypointError keypoint_error(const CorrespondenceMap& map, const std::vector<Mesh>& meshes,
+                             const std::vector<Normalization>& frames,
+                             const std::vector<std::vector<int>>& keypoints,
+                             const std::vector<double>& thresholds) {
   const size_t n = meshes.size();
   JSA_CHECK(frames.size() == n && keypoints.size() == n, "one mesh, frame and keypoint list per shape");
   const size_t k = keypoints[0].size();
@@ -63,7 +74,7 @@ KeypointError keypoint_error(Atlas<float>& atlas, const std::vector<Mesh>& meshe
     }
     for (size_t j = 0; j < n; ++j) {
       if (i == j) continue;
-      const Block<double> q = correspond(atlas, int(i), int(j), p, pn, o);
+      const Block<double> q = map(int(i), int(j), p, pn);
       const Block<double> target = frames[j].to_unit(meshes[j].vertices);
       double pair = 0;
       for (size_t m = 0; m < k; ++m) {

@@ -4,6 +4,7 @@
 // P, map the samples to shape I by phi_I, take the one whose image is nearest
 // to p, and map that 2D point by phi_J.
 #pragma once
+#include <functional>
 #include <vector>
 
 #include "io/mesh.h"
@@ -34,7 +35,21 @@ struct KeypointError {
   std::vector<std::vector<double>> pair_mean;  // [I][J] mean error (0 on the diagonal)
 };
 
-// meshes/frames/keypoints per shape of the collection, keypoints[i][k] a vertex of meshes[i].
+// Any model's correspondence map: points p_unit (N x 3, unit frame of shape
+// `from`) with their unit normals -> N x 3 points on shape `to`, its unit frame.
+using CorrespondenceMap = std::function<Block<double>(int from, int to, const Block<double>& p_unit,
+                                                      const Block<double>& normals)>;
+
+// The paper's metric for `map`: keypoints of every shape I carried to every
+// other shape J, the error measured against J's own keypoints (unit frame of J),
+// averaged over all ordered pairs. meshes/frames/keypoints per shape of the
+// collection, keypoints[i][k] a vertex of meshes[i].
+KeypointError keypoint_error(const CorrespondenceMap& map, const std::vector<Mesh>& meshes,
+                             const std::vector<Normalization>& frames,
+                             const std::vector<std::vector<int>>& keypoints,
+                             const std::vector<double>& thresholds = {0.01, 0.02, 0.05, 0.1});
+
+// The same for a joint atlas, its map being correspond() above.
 KeypointError keypoint_error(Atlas<float>& atlas, const std::vector<Mesh>& meshes,
                              const std::vector<Normalization>& frames,
                              const std::vector<std::vector<int>>& keypoints, const CorrespondenceOptions& o,

@@ -33,4 +33,12 @@ Evaluation evaluate_reconstruction(Atlas<float>& atlas, const Mesh& shape,
                                    const Normalization& normalization, const EvaluationOptions& o,
                                    int index = 0);
 
+// The same metrics for any model's M' predicted points and unit normals (unit
+// frame of `shape`): the shape is sampled as above, so two models evaluated
+// with the same options meet the same ground-truth samples (the baselines of
+// model/atlasnet.h are scored this way).
+Evaluation evaluate_points(const Block<double>& points, const Block<double>& normals,
+                           const Mesh& shape, const Normalization& normalization,
+                           const EvaluationOptions& o);
+
 }  // namespace jsa

@@ -48,7 +48,8 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
                 {"hidden_layers", o.atlas.hidden_layers},
                 {"alpha", o.atlas.alpha},
                 {"shapes", o.atlas.shapes},
-                {"code_size", o.atlas.code_size}};
+                {"code_size", o.atlas.code_size},
+                {"code_layer", o.atlas.code_layer}};
   j["weights"] = {{"surface_6d", o.weights.surface},
                   {"chart_2d", o.weights.chart},
                   {"cycle", o.weights.cycle},
@@ -103,6 +104,7 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   field(a, "atlas.", "alpha", o.atlas.alpha);
   field(a, "atlas.", "shapes", o.atlas.shapes);
   field(a, "atlas.", "code_size", o.atlas.code_size);
+  if (a.contains("code_layer")) field(a, "atlas.", "code_layer", o.atlas.code_layer);  // later addition: absent = 0
   const json& w = j.contains("weights") ? j["weights"] : json();
   field(w, "weights.", "surface_6d", o.weights.surface);
   field(w, "weights.", "chart_2d", o.weights.chart);
@@ -132,7 +134,7 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   field(j, "", "pool", o.pool);
   field(j, "", "threads", o.threads);
   if (o.atlas.gaussians <= 0 || o.atlas.width <= 0 || o.atlas.hidden_layers < 0 || o.points <= 0 ||
-      o.atlas.shapes <= 0 || o.atlas.code_size <= 0 || o.pool <= 0 || o.threads < 0 || o.orient_every < 0 || o.batch_shapes < 0 || !(o.lr > 0) ||
+      o.atlas.shapes <= 0 || o.atlas.code_size <= 0 || o.pool <= 0 || o.threads < 0 || o.orient_every < 0 || o.batch_shapes < 0 || o.atlas.code_layer < 0 || o.atlas.code_layer > 1 || !(o.lr > 0) ||
       !std::isfinite(o.lr))
     throw InputError(what + ": sizes must be positive");
   // The same bounds as the command line's, so a crafted file cannot make the

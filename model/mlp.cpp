@@ -16,9 +16,11 @@ Mlp<T>::Mlp(Parameters<T>& params, const std::string& name, const MlpShape& shap
     bias_.push_back(params.add(name + ".b" + std::to_string(k), 1, out));
     in = out;
   }
+  JSA_CHECK(shape.code_layer == 0 || (shape.code_layer == 1 && shape.hidden_layers >= 1),
+            "the code enters at layer 0 or 1 (after the first), got " << shape.code_layer);
   if (shape.code_size > 0) {
-    const int first_out = shape.hidden_layers > 0 ? shape.width : shape.out;
-    code_weight_ = params.add(name + ".wf", shape.code_size, first_out);
+    const int out = shape.code_layer < shape.hidden_layers ? shape.width : shape.out;
+    code_weight_ = params.add(name + ".wf", shape.code_size, out);
   }
 }
 
@@ -32,9 +34,10 @@ void Mlp<T>::initialize(Parameters<T>& params, Rng& rng) const {
     for (Index i = 0; i < b.size(); ++i) b.data()[i] = T(rng.uniform(-bound, bound));
   }
   if (code_weight_ >= 0) {
-    // As if W_f were the code's rows of one (in + D) x width first layer.
+    // As if W_f were the code's rows of one (in + D) x out layer.
     auto w = params.value(code_weight_);
-    const double bound = 1.0 / std::sqrt(double(shape_.in + shape_.code_size));
+    const int in = shape_.code_layer == 0 ? shape_.in : shape_.width;
+    const double bound = 1.0 / std::sqrt(double(in + shape_.code_size));
     for (Index i = 0; i < w.size(); ++i) w.data()[i] = T(rng.uniform(-bound, bound));
   }
 }
@@ -48,8 +51,9 @@ Var Mlp<T>::forward(Tape<T>& t, Parameters<T>& params, Var x, Index value_rows, 
   Var h = x;
   for (size_t k = 0; k < weight_.size(); ++k) {
     Var bias = params.on(t, bias_[k]);
-    // [x, f] W = x W_x + f W_f: the code enters as part of the first bias.
-    if (k == 0 && code.valid()) bias = add(t, bias, linear(t, code, params.on(t, code_weight_), Var{}));
+    // [h, f] W = h W_h + f W_f: the code enters as part of layer code_layer's bias.
+    if (int(k) == shape_.code_layer && code.valid())
+      bias = add(t, bias, linear(t, code, params.on(t, code_weight_), Var{}));
     h = linear(t, h, params.on(t, weight_[k]), bias, value_rows);
     if (k + 1 < weight_.size()) h = relu_masked(t, h, value_rows);
   }

@@ -13,6 +13,9 @@
 // layer's bias, so that is how it is computed: one 1 x D by D x width product
 // per call instead of D extra columns in the first GEMM. As a bias, it touches
 // only the value rows: the code does not change with (u, v).
+// code_layer = 1 instead adds f W_f after the first layer (to the second
+// layer's pre-activation): the other conditioning the paper's Sec. 3.4 leaves
+// open. Both are measured in docs/results.md; input (0) is the default.
 #pragma once
 #include <string>
 #include <vector>
@@ -29,6 +32,7 @@ struct MlpShape {
   int width = 256;        // units per hidden layer
   int hidden_layers = 5;  // ReLU layers before the linear output layer
   int code_size = 0;      // D: latent code width (0: no code)
+  int code_layer = 0;     // the layer whose bias takes f W_f: 0 (= concatenation at the input) or 1
 };
 
 template <class T>

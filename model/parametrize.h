@@ -5,6 +5,8 @@
 // and the normal n = alpha (J_u x J_v) / |J_u x J_v| (Eq. 2) and the isometry
 // term (Eq. 10) are differentiated exactly by backward().
 #pragma once
+#include <string>
+
 #include "model/mlp.h"
 
 namespace jsa {
@@ -20,9 +22,12 @@ template <class T>
 class Parametrization {
  public:
   Parametrization() = default;
-  // in = 2, out = 3 (code_size: the latent code width in a collection).
-  Parametrization(Parameters<T>& params, const MlpShape& shape, T alpha)
-      : mlp_(params, "phi", shape), alpha_(alpha) {}
+  // in = 2, out = 3 (code_size: the latent code width in a collection). name:
+  // the prefix of its parameters; a model with several (AtlasNet's patches,
+  // model/atlasnet.h) gives each its own.
+  Parametrization(Parameters<T>& params, const MlpShape& shape, T alpha,
+                  const std::string& name = "phi")
+      : mlp_(params, name, shape), alpha_(alpha) {}
   void initialize(Parameters<T>& params, Rng& rng) const { mlp_.initialize(params, rng); }
   // x: M x 2 domain points. with_jacobian = false evaluates phi(x) alone.
   // code: the shape's latent code f_phi,i (1 x D) in a collection, else none.

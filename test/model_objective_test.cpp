@@ -86,6 +86,8 @@ TEST_CASE("objective: gradients of L_full for a collection (latent codes) match 
   ao.hidden_layers = 2;
   ao.shapes = 2;
   ao.code_size = 4;
+  ao.code_layer = GENERATE(0, 1);  // codes at the input, and after the first layer
+  INFO("code_layer " << ao.code_layer);
   Atlas<double> atlas(ao);
   Rng init(5);
   atlas.initialize(init);
