@@ -57,22 +57,23 @@ Block<float> random_block(Index n, Index c, Rng& rng, double scale = 1) {
 // Forward + backward FLOPs of an MLP on `rows` rows (first layer has no dX).
 double mlp_flops(const Mlp<float>& mlp, Index rows) { return 3.0 * mlp.flops(rows) - 2.0 * rows * mlp.shape().in * mlp.shape().width; }
 
-// The same GEMMs as an MLP step, in plain Eigen: Y = X W, dW = X^T dY, dX = dY W^T.
+// The same GEMMs as an MLP step, in plain Eigen: Y = X W, dW = X^T dY, dX = dY W^T,
+// into preallocated outputs (noalias), so the bound is the GEMM kernels alone.
 double sgemm_ms(const std::vector<int>& widths, Index rows, int runs) {
   Rng rng(3);
-  std::vector<Block<float>> x, w;
+  std::vector<Block<float>> x, w, y, dw, dx;
   for (size_t l = 0; l + 1 < widths.size(); ++l) {
     x.push_back(random_block(rows, widths[l], rng));
     w.push_back(random_block(widths[l], widths[l + 1], rng, 0.05));
+    y.emplace_back(rows, widths[l + 1]);
+    dw.emplace_back(widths[l], widths[l + 1]);
+    dx.emplace_back(rows, widths[l]);
   }
   return median_ms(runs, [&]() {
     for (size_t l = 0; l < w.size(); ++l) {
-      Block<float> y = x[l] * w[l];
-      Block<float> dw = x[l].transpose() * y;
-      if (l > 0) {
-        Block<float> dx = y * w[l].transpose();
-        (void)dx;
-      }
+      y[l].noalias() = x[l] * w[l];
+      dw[l].noalias() = x[l].transpose() * y[l];
+      if (l > 0) dx[l].noalias() = y[l] * w[l].transpose();
     }
   });
 }
