@@ -36,6 +36,11 @@ int main(int argc, char** argv) {
   o.atlas.gaussians = 2500;
   o.atlas.width = 128;
   int threads = 0;
+  for (int i = 1; i < argc + (argc % 2 == 0 ? 1 : 0); ++i)
+    if (i == argc || std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0) {  // help, or a flag without its value
+      std::printf("usage: bench_cube_faces [--iters N] [--points M] [--gaussians K] [--width W] [--seed S] [--threads T]\n");
+      return i == argc ? 2 : 0;
+    }
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string f = argv[i];
     const char* v = argv[i + 1];

@@ -84,6 +84,11 @@ int main(int argc, char** argv) {
   FitOptions o;
   int threads = 0, runs = 5;
   std::string csv;
+  for (int i = 1; i < argc + (argc % 2 == 0 ? 1 : 0); ++i)
+    if (i == argc || std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {  // help, or a flag without its value
+      std::printf("usage: bench_iteration [--points M] [--gaussians K] [--width W] [--depth D] [--threads T] [--runs R] [--csv FILE]\n");
+      return i == argc ? 2 : 0;
+    }
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string f = argv[i];
     const long v = std::atol(argv[i + 1]);
