@@ -175,9 +175,7 @@ void AtlasNetTrainer::step() {
     // Chamfer-only baselines have not needed one).
     lr_scale_ *= 0.5;
     if (++faults_in_a_row_ > options_.max_faults)
-      throw NumericalFault("training diverged: NaN/Inf " + std::to_string(faults_in_a_row_) +
-                           " times in a row at iteration " + std::to_string(iteration_) +
-                           " (try a smaller --lr)");
+      throw NumericalFault(faults_in_a_row_, iteration_);
     return;
   }
   faults_in_a_row_ = 0;

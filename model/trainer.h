@@ -9,6 +9,7 @@
 #include <iosfwd>
 #include <memory>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "engine/adam.h"
@@ -65,6 +66,9 @@ struct Progress {
 // Thrown when training keeps producing NaN/Inf after max_faults recoveries.
 struct NumericalFault : std::runtime_error {
   using std::runtime_error::runtime_error;
+  NumericalFault(int faults_in_a_row, int64_t iteration)
+      : std::runtime_error("training diverged: NaN/Inf " + std::to_string(faults_in_a_row) +
+                           " times in a row at iteration " + std::to_string(iteration) + " (try a smaller --lr)") {}
 };
 
 class Trainer {

@@ -9,22 +9,12 @@
 #include "losses/nearest.h"
 #include "model/atlasnet.h"
 #include "model/correspondence.h"
+#include "test/sphere_pool.h"
 
 using namespace jsa;
+using test_support::sphere_pool;
 
 namespace {
-
-// P x 6 [x, n] on the unit sphere.
-Block<double> sphere_pool(Index n, uint64_t seed) {
-  Rng rng(seed);
-  Block<double> pool(n, 6);
-  for (Index i = 0; i < n; ++i) {
-    Eigen::RowVector3d p(rng.normal(), rng.normal(), rng.normal());
-    p.normalize();
-    pool.row(i) << p, p;
-  }
-  return pool;
-}
 
 double objective_value(AtlasNet<double>& net, const std::vector<Block<double>>& targets,
                        Tape<double>& tape, bool backward) {

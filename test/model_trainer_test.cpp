@@ -7,22 +7,12 @@
 
 #include "engine/parallel.h"
 #include "model/trainer.h"
+#include "test/sphere_pool.h"
 
 using namespace jsa;
+using test_support::sphere_pool;
 
 namespace {
-
-// P x 6 [x, n] on the unit sphere.
-Block<double> sphere_pool(Index n, uint64_t seed) {
-  Rng rng(seed);
-  Block<double> pool(n, 6);
-  for (Index i = 0; i < n; ++i) {
-    Eigen::RowVector3d p(rng.normal(), rng.normal(), rng.normal());
-    p.normalize();
-    pool.row(i) << p, p;
-  }
-  return pool;
-}
 
 FitOptions small_options() {
   FitOptions o;
