@@ -138,6 +138,20 @@ void run_fit(FitArgs& a) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   using clock = std::chrono::steady_clock;
+  double wrap_seconds = 0;
+  if (!resuming && o.wrap_steps > 0) {
+    const auto w0 = clock::now();
+    const WrapReport w = trainer.wrap([] { return g_signal != 0; });
+    wrap_seconds = std::chrono::duration<double>(clock::now() - w0).count();
+    if (g_signal) {
+      // Nothing trained yet: a checkpoint would hold a half-fitted wrap.
+      std::cerr << "fit: interrupted while wrapping (before training); no checkpoint written\n";
+      throw ExitCode{130};
+    }
+    if (!a.quiet)
+      std::cerr << "fit: phi and psi wrapped around the shape's ellipsoid (" << o.wrap_steps << " steps, "
+                << format_duration(wrap_seconds) << "; RMS error phi " << w.phi_error << ", psi " << w.psi_error << ")\n";
+  }
   const auto start = clock::now();
   auto last_print = start;
   const int64_t first = trainer.iteration();
@@ -149,7 +163,7 @@ void run_fit(FitArgs& a) {
   while (!trainer.finished() || !sized) {
     if (!sized && trainer.iteration() - first == probe) {
       const double per = std::chrono::duration<double>(clock::now() - start).count() / double(probe);
-      const int64_t n = std::max<int64_t>(probe + 1, int64_t(a.minutes * 60.0 / per * 0.97));
+      const int64_t n = std::max<int64_t>(probe + 1, int64_t((a.minutes * 60.0 - wrap_seconds) / per * 0.97));
       trainer.set_iterations(n);
       o.iterations = n;
       sized = true;
@@ -248,7 +262,9 @@ void add_fit(CLI::App& app) {
   c->add_option("--preset", a->preset, "paper: M = K = 10^4, 5 x 256 MLPs (slow on a laptop)");
   c->add_option("--pool", o.pool, "Surface samples drawn once from the input")->capture_default_str()->check(CLI::Range(Index(100), Index(10000000)));
   c->add_option("--repulsion-tolerance", o.repulsion_tolerance, "Bound on the error of L_rep from its cut-off radius")->capture_default_str()->check(CLI::Range(1e-15, 1e-2))->check(kFinite);
+  c->add_option("--softplus", o.atlas.softplus_beta, "Activation of phi and psi: 0 ReLU (the paper), BETA > 0 softplus log(1 + e^(BETA z)) / BETA (smooth normals)")->capture_default_str()->check(CLI::NonNegativeNumber)->check(CLI::Range(0.0, 1e6));
   c->add_option("--code-layer", o.atlas.code_layer, "Collections: where the codes enter phi and psi: 0 the input (concatenation), 1 after the first layer")->capture_default_str()->check(CLI::Range(0, 1));
+  c->add_option("--wrap", o.wrap_steps, "Steps fitting phi and psi to a closed ellipsoid around the shape before training (0: random start, as the paper; see model/wrap.h)")->capture_default_str()->check(CLI::Range(0, 1000000));
   c->add_option("--batch-shapes", o.batch_shapes, "Collections: shapes per iteration, a seeded random subset (0: all); the loss is scaled by N/B")->capture_default_str()->check(CLI::NonNegativeNumber);
   c->add_option("--orient-every", o.orient_every, "Choose phi's global orientation every N iterations until the first decay (0: never; see model/orientation.h)")->capture_default_str()->check(CLI::NonNegativeNumber);
   c->add_option("--checkpoint-every", a->checkpoint_every, "Write model.ckpt every N iterations (0: only at the end)")->capture_default_str()->check(CLI::NonNegativeNumber);

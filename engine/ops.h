@@ -1,6 +1,7 @@
 // The op library. Each op appends one node to the tape; its pull-back sits right
 // below its forward in the .cpp files, with the local derivative in a comment:
-//   ops_linear.cpp      linear (X W + b), relu, relu_masked (stacked tangents)
+//   ops_linear.cpp      linear (X W + b), relu, relu_masked, softplus_stacked
+//                       (the last two on stacked tangents)
 //   ops_elementwise.cpp add/sub/mul (row broadcasting), scale, offset, square,
 //                       sqrt, exp
 //   ops_rows.cpp        concat/slice of columns and rows, gather rows by index
@@ -25,6 +26,10 @@ template <class T> Var relu(Tape<T>& t, Var x);
 // mask [value > 0] of the value block multiplies every block (chain rule for
 // d relu(z) = [z > 0] dz).
 template <class T> Var relu_masked(Tape<T>& t, Var x, Index mask_rows);
+// Softplus log(1 + e^(beta z)) / beta on stacked rows (block height m): the value
+// block z goes through it, each tangent block is multiplied by its derivative
+// sigmoid(beta z). A smooth ReLU (beta -> infinity gives ReLU back).
+template <class T> Var softplus_stacked(Tape<T>& t, Var x, Index m, T beta);
 
 // ---- elementwise (ops_elementwise.cpp) ----
 // b is either the shape of a, or 1 x C and then broadcast over a's rows,

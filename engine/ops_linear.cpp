@@ -1,4 +1,7 @@
-// linear and ReLU: the two ops an MLP is made of, in plain and stacked-tangent form.
+// linear and the activations (ReLU, softplus): the ops an MLP is made of, in
+// plain and stacked-tangent form.
+#include <cmath>
+
 #include "engine/ops.h"
 #include "engine/parallel.h"
 
@@ -71,10 +74,64 @@ Var relu_masked(Tape<T>& t, Var x, Index m) {
   return y;
 }
 
+// Softplus on stacked rows, value block z (rows 0..m) and tangent blocks x_k:
+//   y_0 = s(z) = log(1 + exp(beta z)) / beta,   y_k = s'(z) x_k,   s'(z) = sigmoid(beta z).
+// Unlike ReLU, s' is smooth, so the Jacobian (hence the normal of Eq. 2) varies
+// continuously over the domain; the price is the second derivative in the
+// pull-back:  dz += dy_0 s'(z) + sum_k dy_k x_k s''(z),  s'' = beta s' (1 - s'),
+//             dx_k += dy_k s'(z).
+template <class T>
+Var softplus_stacked(Tape<T>& t, Var x, Index m, T beta) {
+  const Index n = t.rows(x), c = t.cols(x);
+  JSA_CHECK(m > 0 && n % m == 0, "softplus_stacked: " << n << " rows is not a multiple of " << m);
+  JSA_CHECK(beta > T(0), "softplus_stacked: beta must be positive, got " << beta);
+  Var y = t.node(n, c, {x});
+  const Block<T>& X = t.value(x);
+  Block<T>& Y = t.value(y);
+  const Index blocks = n / m;
+  // Whole-row-range array expressions, so Eigen vectorises exp and log1p.
+  // log(1 + e^bz) = max(bz, 0) + log1p(e^-|bz|) and sigmoid(bz) = 1 / (1 + e^-bz)
+  // written with e = e^-|bz| <= 1: neither overflows for any bz.
+  parallel_rows(m, [&](Index r0, Index r1) {
+    const auto bz = beta * X.middleRows(r0, r1 - r0).array();
+    const Eigen::Array<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> e = (-bz.abs()).exp();
+    Y.middleRows(r0, r1 - r0).array() = (bz.max(T(0)) + e.log1p()) / beta;
+    if (blocks > 1) {
+      const Eigen::Array<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> s1 =
+          (bz >= T(0)).select(T(1) / (T(1) + e), e / (T(1) + e));
+      for (Index k = 1; k < blocks; ++k)
+        Y.middleRows(k * m + r0, r1 - r0).array() = s1 * X.middleRows(k * m + r0, r1 - r0).array();
+    }
+  });
+  t.on_backward(y, [x, m, blocks, beta](Tape<T>& t, Var y) {
+    const Block<T>& X = t.value(x);
+    const Block<T>& dY = t.grad(y);
+    Block<T>& dX = t.grad(x);
+    parallel_rows(m, [&](Index r0, Index r1) {
+      const Index h = r1 - r0;
+      const auto bz = beta * X.middleRows(r0, h).array();
+      const Eigen::Array<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> e = (-bz.abs()).exp();
+      const Eigen::Array<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> s1 =
+          (bz >= T(0)).select(T(1) / (T(1) + e), e / (T(1) + e));
+      Eigen::Array<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> dz = dY.middleRows(r0, h).array() * s1;
+      if (blocks > 1) {
+        const Eigen::Array<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> s2 = beta * s1 * (T(1) - s1);
+        for (Index k = 1; k < blocks; ++k) {
+          dz += dY.middleRows(k * m + r0, h).array() * X.middleRows(k * m + r0, h).array() * s2;
+          dX.middleRows(k * m + r0, h).array() += dY.middleRows(k * m + r0, h).array() * s1;
+        }
+      }
+      dX.middleRows(r0, h).array() += dz;
+    });
+  });
+  return y;
+}
+
 #define JSA_INSTANTIATE(T)                                    \
   template Var linear<T>(Tape<T>&, Var, Var, Var, Index);     \
   template Var relu<T>(Tape<T>&, Var);                        \
-  template Var relu_masked<T>(Tape<T>&, Var, Index);
+  template Var relu_masked<T>(Tape<T>&, Var, Index);          \
+  template Var softplus_stacked<T>(Tape<T>&, Var, Index, T);
 JSA_INSTANTIATE(float)
 JSA_INSTANTIATE(double)
 

@@ -19,6 +19,7 @@ struct AtlasOptions {
   int shapes = 1;           // N shapes sharing the domain (Sec. 3.4); > 1 adds latent codes
   int code_size = 256;      // D, width of f_phi,i and f_psi,i when shapes > 1 (paper: 256)
   int code_layer = 0;       // where codes enter phi and psi: 0 the input (concatenation), 1 after the first layer
+  double softplus_beta = 0;  // activation of phi and psi: 0 ReLU (paper), > 0 softplus of that sharpness
 };
 
 template <class T>

@@ -49,7 +49,8 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
                 {"alpha", o.atlas.alpha},
                 {"shapes", o.atlas.shapes},
                 {"code_size", o.atlas.code_size},
-                {"code_layer", o.atlas.code_layer}};
+                {"code_layer", o.atlas.code_layer},
+                {"softplus_beta", o.atlas.softplus_beta}};
   j["weights"] = {{"surface_6d", o.weights.surface},
                   {"chart_2d", o.weights.chart},
                   {"cycle", o.weights.cycle},
@@ -72,6 +73,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["max_faults"] = o.max_faults;
   j["orient_every"] = o.orient_every;
   j["batch_shapes"] = o.batch_shapes;
+  j["wrap_steps"] = o.wrap_steps;
   j["pool"] = o.pool;
   j["threads"] = o.threads;
   return j.dump(indent);
@@ -105,6 +107,8 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   field(a, "atlas.", "shapes", o.atlas.shapes);
   field(a, "atlas.", "code_size", o.atlas.code_size);
   if (a.contains("code_layer")) field(a, "atlas.", "code_layer", o.atlas.code_layer);  // later addition: absent = 0
+  o.atlas.softplus_beta = 0;  // later addition: absent = ReLU, what older runs used
+  if (a.contains("softplus_beta")) field(a, "atlas.", "softplus_beta", o.atlas.softplus_beta);
   const json& w = j.contains("weights") ? j["weights"] : json();
   field(w, "weights.", "surface_6d", o.weights.surface);
   field(w, "weights.", "chart_2d", o.weights.chart);
@@ -131,17 +135,20 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   o.orient_every = 0;
   if (j.contains("orient_every")) field(j, "", "orient_every", o.orient_every);
   if (j.contains("batch_shapes")) field(j, "", "batch_shapes", o.batch_shapes);
+  o.wrap_steps = 0;
+  if (j.contains("wrap_steps")) field(j, "", "wrap_steps", o.wrap_steps);
   field(j, "", "pool", o.pool);
   field(j, "", "threads", o.threads);
   if (o.atlas.gaussians <= 0 || o.atlas.width <= 0 || o.atlas.hidden_layers < 0 || o.points <= 0 ||
-      o.atlas.shapes <= 0 || o.atlas.code_size <= 0 || o.pool <= 0 || o.threads < 0 || o.orient_every < 0 || o.batch_shapes < 0 || o.atlas.code_layer < 0 || o.atlas.code_layer > 1 || !(o.lr > 0) ||
+      o.atlas.shapes <= 0 || o.atlas.code_size <= 0 || o.pool <= 0 || o.threads < 0 || o.orient_every < 0 || o.batch_shapes < 0 || o.wrap_steps < 0 || o.atlas.code_layer < 0 || o.atlas.code_layer > 1 || !(o.lr > 0) ||
+      !(o.atlas.softplus_beta >= 0) || !std::isfinite(o.atlas.softplus_beta) ||
       !std::isfinite(o.lr))
     throw InputError(what + ": sizes must be positive");
   // The same bounds as the command line's, so a crafted file cannot make the
   // atlas allocate without limit.
   if (o.atlas.gaussians > 1000000 || o.atlas.width > 4096 || o.atlas.hidden_layers > 32 ||
       o.atlas.code_size > 4096 || o.atlas.shapes > 100000 || o.points > 1000000 || o.pool > 10000000 ||
-      o.threads > 1024)
+      o.threads > 1024 || o.wrap_steps > 1000000)
     throw InputError(what + ": a size is beyond the command line's limits (corrupt settings?)");
   return o;
 }

@@ -16,6 +16,7 @@ Mlp<T>::Mlp(Parameters<T>& params, const std::string& name, const MlpShape& shap
     bias_.push_back(params.add(name + ".b" + std::to_string(k), 1, out));
     in = out;
   }
+  JSA_CHECK(shape.softplus_beta >= 0, "softplus beta must be >= 0 (0: ReLU), got " << shape.softplus_beta);
   JSA_CHECK(shape.code_layer == 0 || (shape.code_layer == 1 && shape.hidden_layers >= 1),
             "the code enters at layer 0 or 1 (after the first), got " << shape.code_layer);
   if (shape.code_size > 0) {
@@ -55,7 +56,9 @@ Var Mlp<T>::forward(Tape<T>& t, Parameters<T>& params, Var x, Index value_rows, 
     if (int(k) == shape_.code_layer && code.valid())
       bias = add(t, bias, linear(t, code, params.on(t, code_weight_), Var{}));
     h = linear(t, h, params.on(t, weight_[k]), bias, value_rows);
-    if (k + 1 < weight_.size()) h = relu_masked(t, h, value_rows);
+    if (k + 1 < weight_.size())
+      h = shape_.softplus_beta > 0 ? softplus_stacked(t, h, value_rows, T(shape_.softplus_beta))
+                                   : relu_masked(t, h, value_rows);
   }
   return h;
 }

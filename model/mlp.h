@@ -16,6 +16,11 @@
 // code_layer = 1 instead adds f W_f after the first layer (to the second
 // layer's pre-activation): the other conditioning the paper's Sec. 3.4 leaves
 // open. Both are measured in docs/results.md; input (0) is the default.
+//
+// Activation: ReLU as the paper, or softplus (softplus_beta > 0). With ReLU phi
+// is piecewise linear, so its normals (Eq. 2) are piecewise constant and jump
+// between the linear pieces; softplus makes them continuous. Measured against
+// each other in docs/results.md.
 #pragma once
 #include <string>
 #include <vector>
@@ -33,6 +38,7 @@ struct MlpShape {
   int hidden_layers = 5;  // ReLU layers before the linear output layer
   int code_size = 0;      // D: latent code width (0: no code)
   int code_layer = 0;     // the layer whose bias takes f W_f: 0 (= concatenation at the input) or 1
+  double softplus_beta = 0;  // 0: ReLU (the paper); > 0: softplus log(1 + e^(beta z)) / beta
 };
 
 template <class T>

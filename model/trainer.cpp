@@ -47,7 +47,15 @@ void Trainer::take_snapshot() {
   good_steps_ = adam_.steps();
 }
 
+WrapReport Trainer::wrap(const std::function<bool()>& cancelled) {
+  if (wrapped_ || iteration_ > 0 || options_.wrap_steps <= 0) return {};
+  wrapped_ = true;
+  Rng rng(options_.seed, 2);  // its own stream: the training draws are the same with or without it
+  return wrap_initialize(*atlas_, pools_, options_.wrap_steps, options_.points, options_.lr, rng, cancelled);
+}
+
 void Trainer::step() {
+  if (iteration_ == 0 && !wrapped_) wrap();
   const int n = int(pools_.size()), b = int(batch_.size());
   if (b < n) {
     // A uniform subset of B shapes: the first B of a partial Fisher-Yates shuffle.

@@ -14,6 +14,7 @@
 
 #include "engine/adam.h"
 #include "model/objective.h"
+#include "model/wrap.h"
 
 namespace jsa {
 
@@ -45,6 +46,9 @@ struct FitOptions {
   // Collections: shapes per step, drawn without replacement from the seeded
   // stream (0 or >= N: all N). A step costs about B single-shape steps.
   int batch_shapes = 0;
+  // Adam steps fitting phi and psi to a closed wrap of each shape before
+  // training (model/wrap.h); 0: start from the random initialisation as the paper.
+  int wrap_steps = 0;
 };
 
 // The paper's configuration (Sec. 3, implementation details).
@@ -83,6 +87,10 @@ class Trainer {
   // Adam sees it: the last good state is restored, the learning rate halved,
   // and the batch skipped; after max_faults such steps in a row, NumericalFault.
   void step();
+  // Fits the starting wrap (model/wrap.h) if options().wrap_steps > 0 and it
+  // has not run; step() calls it before the first iteration. A resumed run
+  // (iteration > 0) never wraps.
+  WrapReport wrap(const std::function<bool()>& cancelled = {});
   double learning_rate() const;  // the schedule at the current iteration, times the fault scale
   int faults() const { return faults_total_; }
   int mirrors() const { return mirrors_; }  // times the domain was mirrored (model/orientation.h)
@@ -124,6 +132,7 @@ class Trainer {
   int64_t fault_at_ = -1;
   int faults_to_inject_ = 0;
   int mirrors_ = 0;
+  bool wrapped_ = false;
   void take_snapshot();
   void choose_orientation();
 };

@@ -146,3 +146,21 @@ TEST_CASE("cli: a collection with a shape batch and a user texture writes the te
   CHECK(!fs::exists(other + "/model.ckpt"));
   fs::remove(texture);
 }
+
+TEST_CASE("cli: the starting wrap is reported, and Ctrl-C during it writes no checkpoint", "[cli]") {
+  const std::string dir = fresh_dir("wrap");
+  Result r = run("fit builtin:capsule -o " + dir + " --iters 5 --wrap 30" +
+                 kSmall.substr(0, kSmall.size() - 3));  // without -q: the progress lines
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  CHECK(r.output.find("wrapped around the shape's ellipsoid (30 steps") != std::string::npos);
+  CHECK(read_text(dir + "/config.json").find("\"wrap_steps\": 30") != std::string::npos);
+  // A wrap that would take hours, interrupted once the run has started.
+  const std::string stopped = fresh_dir("wrap_interrupted");
+  r = run("fit builtin:capsule -o " + stopped + " --iters 5 --wrap 1000000" + kSmall + " 2>&1 & pid=$!; while [ ! -f " +
+          stopped + "/config.json ]; do sleep 0.01; done; sleep 0.3; kill -INT $pid; wait $pid; echo exit=$?");
+  INFO(r.output);
+  CHECK(r.output.find("exit=130") != std::string::npos);
+  CHECK(r.output.find("interrupted while wrapping") != std::string::npos);
+  CHECK_FALSE(fs::exists(stopped + "/model.ckpt"));
+}

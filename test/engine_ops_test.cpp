@@ -46,6 +46,12 @@ std::vector<GradCase> op_cases() {
   // Value rows away from 0 (the mask); the tangent rows may be anything.
   add_case("relu_masked", [n](T& t, const Vs& x) { return relu_masked(t, x[0], n); },
            {signed_block(rng, 3 * n, c)});
+  // Smooth, so no kink to keep away from; beta = 3 puts the inputs in the curved
+  // part, where the second derivative (the tangent rows' pull-back into z) matters.
+  add_case("softplus_stacked", [n](T& t, const Vs& x) { return softplus_stacked(t, x[0], n, 3.0); },
+           {signed_block(rng, 3 * n, c)});
+  add_case("softplus_stacked (plain rows)", [n](T& t, const Vs& x) { return softplus_stacked(t, x[0], n, 0.5); },
+           {signed_block(rng, n, c)});
 
   // ---- elementwise, all four broadcast shapes of b ----
   struct Shape {

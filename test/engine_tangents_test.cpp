@@ -30,12 +30,13 @@ std::vector<Block<double>> mlp_weights(uint64_t seed) {
 }
 
 // The network on the tape, stacked: [x; e_u; e_v] -> [f; f_u; f_v].
-// p = {W1, b1, W2, b2, W3, b3}.
-Stacked mlp_stacked(Tape<double>& t, Var x, const std::vector<Var>& p) {
+// p = {W1, b1, W2, b2, W3, b3}. beta = 0: ReLU; beta > 0: softplus.
+Stacked mlp_stacked(Tape<double>& t, Var x, const std::vector<Var>& p, double beta = 0) {
   const Index n = t.rows(x);
+  auto act = [&](Var z) { return beta > 0 ? softplus_stacked(t, z, n, beta) : relu_masked(t, z, n); };
   Var h = stack_tangents(t, x);
-  h = relu_masked(t, linear(t, h, p[0], p[1], n), n);
-  h = relu_masked(t, linear(t, h, p[2], p[3], n), n);
+  h = act(linear(t, h, p[0], p[1], n));
+  h = act(linear(t, h, p[2], p[3], n));
   return unstack(t, linear(t, h, p[4], p[5], n));
 }
 
@@ -107,6 +108,23 @@ std::vector<GradCase> jacobian_cases() {
                      return concat_cols(t, {s.value, row_normalize(t, cross3(t, s.du, s.dv))});
                    },
                    inputs, o});
+  // Softplus (beta = 2, well inside its curved part): J now varies with x, so
+  // these exercise the second-derivative path of softplus_stacked's pull-back
+  // into the points as well as the weights.
+  cases.push_back({"softplus MLP normals (weights + points)",
+                   [](Tape<double>& t, const std::vector<Var>& v) {
+                     const Stacked s = mlp_stacked(t, v[0], {v.begin() + 1, v.end()}, 2.0);
+                     return row_normalize(t, cross3(t, s.du, s.dv));
+                   },
+                   inputs, o});
+  cases.push_back({"softplus MLP J^T J isometry (weights + points)",
+                   [](Tape<double>& t, const std::vector<Var>& v) {
+                     const Stacked s = mlp_stacked(t, v[0], {v.begin() + 1, v.end()}, 2.0);
+                     Var e = row_dot(t, s.du, s.du), f = row_dot(t, s.du, s.dv), g = row_dot(t, s.dv, s.dv);
+                     return mean(t, add(t, add(t, square(t, offset(t, e, -1.0)), square(t, offset(t, g, -1.0))),
+                                        scale(t, square(t, f), 2.0)));
+                   },
+                   inputs, o});
   return cases;
 }
 
@@ -164,6 +182,54 @@ TEST_CASE("stacked-tangent Jacobian equals Dual<double,2> and finite differences
   // And the Jacobian is not trivially zero.
   CHECK(fu.cwiseAbs().maxCoeff() > 0.1);
   CHECK(fv.cwiseAbs().maxCoeff() > 0.1);
+}
+
+TEST_CASE("softplus stacked tangents equal finite differences of the value", "[tangents]") {
+  const auto w = mlp_weights(11);
+  const Block<double> x = points(12);
+  for (double beta : {0.5, 2.0, 50.0}) {
+    Tape<double> t;
+    std::vector<Var> p;
+    for (const auto& b : w) p.push_back(t.constant(b));
+    const Stacked s = mlp_stacked(t, t.constant(x), p, beta);
+    double worst = 0, largest = 0;
+    for (Index i = 0; i < kPoints; ++i) {
+      // Central differences, step 1e-5: truncation ~h^2 times the third
+      // derivative (beta^2 scale), round-off ~1e-11.
+      const double h = 1e-5;
+      Block<double> xs(4, 2);
+      xs << x(i, 0) + h, x(i, 1), x(i, 0) - h, x(i, 1), x(i, 0), x(i, 1) + h, x(i, 0), x(i, 1) - h;
+      Tape<double> tp;
+      std::vector<Var> pp;
+      for (const auto& b : w) pp.push_back(tp.constant(b));
+      const Block<double> g = tp.value(mlp_stacked(tp, tp.constant(xs), pp, beta).value);
+      for (Index c = 0; c < 3; ++c) {
+        const double fd_u = (g(0, c) - g(1, c)) / (2 * h), fd_v = (g(2, c) - g(3, c)) / (2 * h);
+        worst = std::max({worst, std::abs(t.value(s.du)(i, c) - fd_u), std::abs(t.value(s.dv)(i, c) - fd_v)});
+        largest = std::max({largest, std::abs(fd_u), std::abs(fd_v)});
+      }
+    }
+    INFO("beta " << beta << ": max |tape - finite difference| " << worst << ", largest entry " << largest);
+    CHECK(worst < 1e-6);
+    CHECK(largest > 0.1);
+  }
+}
+
+TEST_CASE("softplus values, and ReLU as beta grows", "[ops]") {
+  Tape<double> t;
+  Block<double> z(2, 3);
+  z << -2, 0, 3,  //
+      0.5, -800, 800;  // exp(800) would overflow without the stable form
+  Block<double> y = t.value(softplus_stacked(t, t.constant(z), 2, 1.0));
+  for (Index i = 0; i < 2; ++i)
+    for (Index j = 0; j < 3; ++j) {
+      const double expect = std::abs(z(i, j)) > 50 ? std::max(z(i, j), 0.0) : std::log1p(std::exp(z(i, j)));
+      CHECK(y(i, j) == Approx(expect).margin(1e-300));
+    }
+  const Block<double> r = t.value(relu_masked(t, t.constant(z), 2));
+  const Block<double> sharp = t.value(softplus_stacked(t, t.constant(z), 2, 1e4));
+  CHECK((sharp - r).cwiseAbs().maxCoeff() < std::log(2.0) / 1e4 + 1e-12);  // the gap is largest at z = 0
+  CHECK_THROWS_AS(softplus_stacked(t, t.constant(z), 2, 0.0), InternalError);
 }
 
 TEST_CASE("gradients through the Jacobian pass check_gradients", "[tangents][gradcheck]") {

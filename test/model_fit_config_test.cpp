@@ -38,12 +38,18 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   jsa::FitOptions o;
   o.orient_every = 25;
   o.batch_shapes = 3;
+  o.wrap_steps = 40;
+  o.atlas.softplus_beta = 7.5;
   const jsa::FitOptions back = jsa::fit_options_from_json(jsa::fit_options_to_json(o), "x");
   CHECK(back.orient_every == 25);
   CHECK(back.batch_shapes == 3);
-  // A checkpoint written before these existed: no orientation check, no batching.
+  CHECK(back.wrap_steps == 40);
+  CHECK(back.atlas.softplus_beta == 7.5);
+  // A checkpoint written before these existed: no orientation check, no
+  // batching, no wrap, ReLU.
   std::string old = jsa::fit_options_to_json(o, -1);
-  for (const std::string key : {"\"orient_every\":25,", "\"batch_shapes\":3,"}) {
+  for (const std::string key : {"\"orient_every\":25,", "\"batch_shapes\":3,", ",\"wrap_steps\":40",
+                                "\"softplus_beta\":7.5,"}) {
     const auto at = old.find(key);
     REQUIRE(at != std::string::npos);
     old.erase(at, key.size());
@@ -51,6 +57,8 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   const jsa::FitOptions legacy = jsa::fit_options_from_json(old, "old");
   CHECK(legacy.orient_every == 0);
   CHECK(legacy.batch_shapes == 0);
+  CHECK(legacy.wrap_steps == 0);
+  CHECK(legacy.atlas.softplus_beta == 0);
   CHECK(message_of(edited("\"batch_shapes\":0", "\"batch_shapes\":-2")) == "run/model.ckpt: sizes must be positive");
 }
 
