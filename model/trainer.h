@@ -19,13 +19,14 @@
 namespace jsa {
 
 // Defaults sized for a laptop (2 cores, ~10 minutes on a SHREC mesh): MLPs of
-// 5 x 128, M = K = 2500, 5000 iterations. The paper's sizes (5 x 256,
-// M = K = 10^4) are `paper_fit_options()`. See docs/results.md for the runs
-// behind this choice.
+// 5 x 128 with softplus (beta = 40) activations, M = K = 2500, 5000
+// iterations. The paper's settings (5 x 256 ReLU, M = K = 10^4) are
+// `paper_fit_options()`. See docs/results.md for the runs behind this choice.
 struct FitOptions {
   FitOptions() {
     atlas.gaussians = 2500;
     atlas.width = 128;
+    atlas.softplus_beta = 40;
   }
   AtlasOptions atlas;          // K, network sizes, alpha
   LossWeights weights;         // the lambdas of Eq. 5 (mean convention)
@@ -57,6 +58,8 @@ inline FitOptions paper_fit_options() {
   o.atlas.gaussians = 10000;
   o.atlas.width = 256;
   o.atlas.hidden_layers = 5;
+  o.atlas.softplus_beta = 0;  // ReLU
+  o.wrap_steps = 0;
   o.points = 10000;
   return o;
 }
