@@ -82,11 +82,14 @@ double sgemm_ms(const std::vector<int>& widths, Index rows, int runs) {
 
 int main(int argc, char** argv) {
   FitOptions o;
+  // ReLU unless --softplus BETA: the peers (bench/peer_torch.py) run the
+  // paper's ReLU MLPs, and the comparison is like for like.
+  o.atlas.softplus_beta = 0;
   int threads = 0, runs = 5;
   std::string csv;
   for (int i = 1; i < argc + (argc % 2 == 0 ? 1 : 0); ++i)
     if (i == argc || std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {  // help, or a flag without its value
-      std::printf("usage: bench_iteration [--points M] [--gaussians K] [--width W] [--depth D] [--threads T] [--runs R] [--csv FILE]\n");
+      std::printf("usage: bench_iteration [--points M] [--gaussians K] [--width W] [--depth D] [--softplus BETA] [--threads T] [--runs R] [--csv FILE]\n");
       return i == argc ? 2 : 0;
     }
   for (int i = 1; i + 1 < argc; i += 2) {
@@ -96,6 +99,7 @@ int main(int argc, char** argv) {
     else if (f == "--gaussians") o.atlas.gaussians = int(v);
     else if (f == "--width") o.atlas.width = int(v);
     else if (f == "--depth") o.atlas.hidden_layers = int(v);
+    else if (f == "--softplus") o.atlas.softplus_beta = std::atof(argv[i + 1]);
     else if (f == "--threads") threads = int(v);
     else if (f == "--runs") runs = int(v);
     else if (f == "--csv") csv = argv[i + 1];

@@ -158,14 +158,19 @@ void run_fit(FitArgs& a) {
   auto last_print = start;
   const int64_t first = trainer.iteration();
   // A time budget: time a few iterations, then set the run's length (and so its
-  // learning-rate schedule) to what fits. The length is recorded in the
-  // checkpoint, so a resumed run follows the same schedule.
-  const int64_t probe = 10;
+  // learning-rate schedule) to what fits. The first iterations allocate the
+  // tape and warm the caches, so they are left out of the timing. The length is
+  // recorded in the checkpoint, so a resumed run follows the same schedule.
+  const int64_t warmup = 5, probe = 20;
+  auto probe_start = start;
   bool sized = !(a.minutes > 0) || resuming;
   while (!trainer.finished() || !sized) {
-    if (!sized && trainer.iteration() - first == probe) {
-      const double per = std::chrono::duration<double>(clock::now() - start).count() / double(probe);
-      const int64_t n = std::max<int64_t>(probe + 1, int64_t((a.minutes * 60.0 - wrap_seconds) / per * 0.97));
+    if (!sized && trainer.iteration() - first == warmup) probe_start = clock::now();
+    if (!sized && trainer.iteration() - first == warmup + probe) {
+      const auto now = clock::now();
+      const double per = std::chrono::duration<double>(now - probe_start).count() / double(probe);
+      const double left = a.minutes * 60.0 - wrap_seconds - std::chrono::duration<double>(now - start).count();
+      const int64_t n = warmup + probe + std::max<int64_t>(1, int64_t(left / per * 0.97));
       trainer.set_iterations(n);
       o.iterations = n;
       sized = true;
@@ -247,7 +252,7 @@ void add_fit(CLI::App& app) {
   c->add_option("--lr", o.lr, "Adam learning rate")->capture_default_str()->check(CLI::PositiveNumber)->check(kFinite);
   c->add_option("--decay", o.decay, "Learning-rate factor at each decay point")->capture_default_str()->check(CLI::Range(0.0, 1.0))->check(kFinite);
   c->add_option("--decay-at", o.decay_at, "Fractions of --iters where the learning rate decays")->capture_default_str()->check(CLI::Range(0.0, 1.0));
-  c->add_option("--minutes", a->minutes, "Time budget: after 10 timed iterations, set --iters to fill it (the schedule follows)")->check(CLI::Range(0.01, 100000.0));
+  c->add_option("--minutes", a->minutes, "Time budget: after 5 warm-up and 20 timed iterations, set --iters to fill it (the schedule follows)")->check(CLI::Range(0.01, 100000.0));
   c->add_option("--seed", o.seed, "Random seed (same seed and threads -> same run)")->capture_default_str();
   c->add_option("--threads", a->threads, "Threads (default: all cores; a resumed run keeps its own, as results depend on it)")->check(CLI::Range(0, 1024));
   c->add_option("--w-6d", o.weights.surface, "lambda_6D on L_6D (Eq. 7)")->capture_default_str()->check(CLI::NonNegativeNumber)->check(kFinite);
