@@ -1,4 +1,4 @@
-// A multi-layer perceptron: `hidden_layers` ReLU layers of `width`, then a
+// A multi-layer perceptron: `hidden_layers` layers of `width` (ReLU, or softplus), then a
 // linear output layer. The paper uses 5 hidden layers of 256 for both phi and
 // psi, no batch norm (Sec. 3, implementation details).
 //
@@ -35,7 +35,7 @@ struct MlpShape {
   int in = 2;             // input features
   int out = 3;            // output features
   int width = 256;        // units per hidden layer
-  int hidden_layers = 5;  // ReLU layers before the linear output layer
+  int hidden_layers = 5;  // activation layers before the linear output layer
   int code_size = 0;      // D: latent code width (0: no code)
   int code_layer = 0;     // the layer whose bias takes f W_f: 0 (= concatenation at the input) or 1
   double softplus_beta = 0;  // 0: ReLU (the paper); > 0: softplus log(1 + e^(beta z)) / beta
