@@ -269,7 +269,7 @@ void add_fit(CLI::App& app) {
   c->add_option("--preset", a->preset, "paper: M = K = 10^4, 5 x 256 ReLU MLPs, no wrap (slow on a laptop)");
   c->add_option("--pool", o.pool, "Surface samples drawn once from the input")->capture_default_str()->check(CLI::Range(Index(100), Index(10000000)));
   c->add_option("--repulsion-tolerance", o.repulsion_tolerance, "Bound on the error of L_rep from its cut-off radius")->capture_default_str()->check(CLI::Range(1e-15, 1e-2))->check(kFinite);
-  c->add_option("--softplus", o.atlas.softplus_beta, "Activation of phi and psi: BETA > 0 softplus log(1 + e^(BETA z)) / BETA (smooth normals), 0 ReLU (the paper)")->capture_default_str()->check(CLI::NonNegativeNumber)->check(CLI::Range(0.0, 1e6));
+  c->add_option("--softplus", o.atlas.softplus_beta, "Activation of phi and psi: BETA > 0 softplus log(1 + e^(BETA z)) / BETA (smooth normals), 0 ReLU (the paper)")->capture_default_str()->check(CLI::Range(0.0, 1e6))->check(kFinite);
   c->add_option("--code-layer", o.atlas.code_layer, "Collections: where the codes enter phi and psi: 0 the input (concatenation), 1 after the first layer")->capture_default_str()->check(CLI::Range(0, 1));
   c->add_option("--wrap", o.wrap_steps, "Steps fitting phi and psi to a closed ellipsoid around the shape before training (0: random start, as the paper; see model/wrap.h)")->capture_default_str()->check(CLI::Range(0, 1000000));
   c->add_option("--batch-shapes", o.batch_shapes, "Collections: shapes per iteration, a seeded random subset (0: all); the loss is scaled by N/B")->capture_default_str()->check(CLI::NonNegativeNumber);

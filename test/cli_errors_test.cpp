@@ -39,6 +39,9 @@ TEST_CASE("cli: bad inputs and flags give one line and a non-zero exit", "[cli]"
   expect_error("fit builtin:sphere -o " + dir + "/out --iters -5", 2, "--iters");
   expect_error("fit builtin:sphere -o " + dir + "/out --points 0", 2, "--points");
   expect_error("fit builtin:sphere -o " + dir + "/out --lr nan", 2, "--lr");
+  expect_error("fit builtin:sphere -o " + dir + "/out --softplus nan", 2, "--softplus");
+  expect_error("fit builtin:sphere -o " + dir + "/out --softplus -1", 2, "--softplus");
+  expect_error("fit builtin:sphere -o " + dir + "/out --wrap -3", 2, "--wrap");
   expect_error("fit builtin:sphere -o " + dir + "/out --table-row 3", 2, "--table-row");
   expect_error("fit builtin:sphere -o " + dir + "/out --no-such-flag", 2, "no-such-flag");
   expect_error("fit builtin:sphere", 1, "-o");
