@@ -84,6 +84,7 @@ void run_fit(FitArgs& a) {
       o.atlas.hidden_layers = paper.atlas.hidden_layers;
       o.atlas.softplus_beta = paper.atlas.softplus_beta;
       o.wrap_steps = paper.wrap_steps;
+      o.reseed_every = paper.reseed_every;
     }
     if (a.table_row) o.components = Components::table_row(a.table_row);
     if (a.no_normals) o.components.normals = false;
@@ -178,7 +179,7 @@ void run_fit(FitArgs& a) {
     }
     if (trainer.finished()) continue;
     const int64_t before = trainer.iteration();
-    const int mirrors = trainer.mirrors();
+    const int mirrors = trainer.mirrors(), reseeded = trainer.reseeded();
     try {
       trainer.step();
     } catch (const NumericalFault& e) {
@@ -194,6 +195,9 @@ void run_fit(FitArgs& a) {
     if (trainer.mirrors() != mirrors && !a.quiet)
       std::fprintf(stderr, "  it %6lld: most normals faced inward; mirrored the domain (u, v) -> (v, u)\n",
                    (long long)trainer.iteration());
+    if (trainer.reseeded() != reseeded && !a.quiet)
+      std::fprintf(stderr, "  it %6lld: moved %d Gaussians off back-facing flaps\n", (long long)trainer.iteration(),
+                   trainer.reseeded() - reseeded);
     const auto now = clock::now();
     const double elapsed = std::chrono::duration<double>(now - start).count();
     if (!a.quiet && (std::chrono::duration<double>(now - last_print).count() > 2.0 || trainer.finished())) {
@@ -271,6 +275,7 @@ void add_fit(CLI::App& app) {
   c->add_option("--repulsion-tolerance", o.repulsion_tolerance, "Bound on the error of L_rep from its cut-off radius")->capture_default_str()->check(CLI::Range(1e-15, 1e-2))->check(kFinite);
   c->add_option("--softplus", o.atlas.softplus_beta, "Activation of phi and psi: BETA > 0 softplus log(1 + e^(BETA z)) / BETA (smooth normals), 0 ReLU (the paper)")->capture_default_str()->check(CLI::Range(0.0, 1e6))->check(kFinite);
   c->add_option("--code-layer", o.atlas.code_layer, "Collections: where the codes enter phi and psi: 0 the input (concatenation), 1 after the first layer")->capture_default_str()->check(CLI::Range(0, 1));
+  c->add_option("--reseed", o.reseed_every, "Every N steps before the first decay, move the Gaussians of back-facing flaps to the surface's holes (0: never, as the paper; see model/reseed.h)")->capture_default_str()->check(CLI::Range(0, 1000000));
   c->add_option("--wrap", o.wrap_steps, "Steps fitting phi and psi to a closed ellipsoid around the shape before training (0: random start, as the paper; see model/wrap.h)")->capture_default_str()->check(CLI::Range(0, 1000000));
   c->add_option("--batch-shapes", o.batch_shapes, "Collections: shapes per iteration, a seeded random subset (0: all); the loss is scaled by N/B")->capture_default_str()->check(CLI::NonNegativeNumber);
   c->add_option("--orient-every", o.orient_every, "Choose phi's global orientation every N iterations until the first decay (0: never; see model/orientation.h)")->capture_default_str()->check(CLI::NonNegativeNumber);

@@ -74,6 +74,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["orient_every"] = o.orient_every;
   j["batch_shapes"] = o.batch_shapes;
   j["wrap_steps"] = o.wrap_steps;
+  j["reseed_every"] = o.reseed_every;
   j["pool"] = o.pool;
   j["threads"] = o.threads;
   return j.dump(indent);
@@ -137,10 +138,12 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (j.contains("batch_shapes")) field(j, "", "batch_shapes", o.batch_shapes);
   o.wrap_steps = 0;
   if (j.contains("wrap_steps")) field(j, "", "wrap_steps", o.wrap_steps);
+  o.reseed_every = 0;
+  if (j.contains("reseed_every")) field(j, "", "reseed_every", o.reseed_every);
   field(j, "", "pool", o.pool);
   field(j, "", "threads", o.threads);
   if (o.atlas.gaussians <= 0 || o.atlas.width <= 0 || o.atlas.hidden_layers < 0 || o.points <= 0 ||
-      o.atlas.shapes <= 0 || o.atlas.code_size <= 0 || o.pool <= 0 || o.threads < 0 || o.orient_every < 0 || o.batch_shapes < 0 || o.wrap_steps < 0 || o.atlas.code_layer < 0 || o.atlas.code_layer > 1 || !(o.lr > 0) ||
+      o.atlas.shapes <= 0 || o.atlas.code_size <= 0 || o.pool <= 0 || o.threads < 0 || o.orient_every < 0 || o.batch_shapes < 0 || o.wrap_steps < 0 || o.reseed_every < 0 || o.atlas.code_layer < 0 || o.atlas.code_layer > 1 || !(o.lr > 0) ||
       !(o.atlas.softplus_beta >= 0) || !std::isfinite(o.atlas.softplus_beta) ||
       !std::isfinite(o.lr))
     throw InputError(what + ": sizes must be positive");

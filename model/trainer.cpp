@@ -8,6 +8,7 @@
 #include <ostream>
 
 #include "model/orientation.h"
+#include "model/reseed.h"
 
 namespace jsa {
 
@@ -100,6 +101,7 @@ void Trainer::step() {
   adam_.step(atlas_->params, learning_rate());
   ++iteration_;
   choose_orientation();
+  reseed();
 }
 
 void Trainer::choose_orientation() {
@@ -116,6 +118,30 @@ void Trainer::choose_orientation() {
   mirror_domain(*atlas_, {&adam_.first_moment(), &adam_.second_moment()});
   ++mirrors_;
   take_snapshot();  // a fault must not restore the unmirrored state
+}
+
+void Trainer::reseed() {
+  const int every = options_.reseed_every;
+  if (every <= 0 || !options_.components.normals || !options_.components.distribution ||
+      iteration_ % every != 0)
+    return;
+  const double first_decay = options_.decay_at.empty() ? 1.0 : options_.decay_at.front();
+  if (double(iteration_) >= first_decay * double(options_.iterations)) return;
+  Rng rng(options_.seed, 3000 + uint64_t(iteration_ / every));
+  // Targets from the pools: more than a step's M, so that holes are seen.
+  const Index count = 4 * options_.points;
+  std::vector<Block<float>> targets;
+  for (int s : batch_) {
+    const Block<float>& pool = pools_[size_t(s)];
+    Block<float> t(count, 6);
+    for (Index m = 0; m < count; ++m) t.row(m) = pool.row(Index(rng.below(uint64_t(pool.rows()))));
+    targets.push_back(std::move(t));
+  }
+  const ReseedReport r =
+      reseed_flipped_means(*atlas_, targets, batch_, rng, {&adam_.first_moment(), &adam_.second_moment()});
+  if (r.flipped == 0) return;
+  reseeded_ += r.flipped;
+  take_snapshot();
 }
 
 // Layout: i64 iteration, 4 x u64 RNG state, i64 Adam steps, f64 lr scale, parameters,

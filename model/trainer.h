@@ -50,6 +50,10 @@ struct FitOptions {
   // Adam steps fitting phi and psi to a closed wrap of each shape before
   // training (model/wrap.h); 0: start from the random initialisation as the paper.
   int wrap_steps = 0;
+  // Every this many iterations before the first decay point, move the Gaussians
+  // of back-facing flaps to the holes of the surface (model/reseed.h); 0: never.
+  // Only with normals in the loss and the distribution P (Table 1 rows 9-11).
+  int reseed_every = 0;
 };
 
 // The paper's configuration (Sec. 3, implementation details).
@@ -60,6 +64,7 @@ inline FitOptions paper_fit_options() {
   o.atlas.hidden_layers = 5;
   o.atlas.softplus_beta = 0;  // ReLU
   o.wrap_steps = 0;
+  o.reseed_every = 0;
   o.points = 10000;
   return o;
 }
@@ -96,7 +101,8 @@ class Trainer {
   WrapReport wrap(const std::function<bool()>& cancelled = {});
   double learning_rate() const;  // the schedule at the current iteration, times the fault scale
   int faults() const { return faults_total_; }
-  int mirrors() const { return mirrors_; }  // times the domain was mirrored (model/orientation.h)
+  int mirrors() const { return mirrors_; }
+  int reseeded() const { return reseeded_; }  // Gaussians moved so far (model/reseed.h)  // times the domain was mirrored (model/orientation.h)
   // Test hook: the next `count` attempts at `iteration` see a NaN loss.
   void inject_faults(int64_t iteration, int count) {
     fault_at_ = iteration;
@@ -135,9 +141,11 @@ class Trainer {
   int64_t fault_at_ = -1;
   int faults_to_inject_ = 0;
   int mirrors_ = 0;
+  int reseeded_ = 0;
   bool wrapped_ = false;
   void take_snapshot();
   void choose_orientation();
+  void reseed();
 };
 
 }  // namespace jsa

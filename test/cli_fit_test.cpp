@@ -147,6 +147,17 @@ TEST_CASE("cli: a collection with a shape batch and a user texture writes the te
   fs::remove(texture);
 }
 
+TEST_CASE("cli: moving flipped Gaussians is reported and saved", "[cli]") {
+  // The inside-out sphere: the random start's sheet faces the wrong way somewhere.
+  const std::string dir = fresh_dir("reseed");
+  Result r = run("fit builtin:sphere -o " + dir + " --iters 40 --reseed 10" + kSmall.substr(0, kSmall.size() - 3));
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  CHECK(r.output.find("Gaussians off back-facing flaps") != std::string::npos);
+  CHECK(read_text(dir + "/config.json").find("\"reseed_every\": 10") != std::string::npos);
+  CHECK(run("fit builtin:sphere -o " + dir + "_bad --reseed -1" + kSmall).code == 2);
+}
+
 TEST_CASE("cli: the starting wrap is reported, and Ctrl-C during it writes no checkpoint", "[cli]") {
   const std::string dir = fresh_dir("wrap");
   Result r = run("fit builtin:capsule -o " + dir + " --iters 5 --wrap 30" +
