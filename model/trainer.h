@@ -20,13 +20,15 @@ namespace jsa {
 
 // Defaults sized for a laptop (2 cores, ~10 minutes on a SHREC mesh): MLPs of
 // 5 x 128 with softplus (beta = 40) activations, M = K = 2500, 5000
-// iterations. The paper's settings (5 x 256 ReLU, M = K = 10^4) are
-// `paper_fit_options()`. See docs/results.md for the runs behind this choice.
+// iterations; normals scaled to alpha = 0.05. The paper's settings (5 x 256
+// ReLU, M = K = 10^4, alpha = 0.01) are `paper_fit_options()`. See docs/method.md and
+// docs/results.md for the runs behind these choices.
 struct FitOptions {
   FitOptions() {
     atlas.gaussians = 2500;
     atlas.width = 128;
     atlas.softplus_beta = 40;
+    atlas.alpha = 0.05;
   }
   AtlasOptions atlas;          // K, network sizes, alpha
   LossWeights weights;         // the lambdas of Eq. 5 (mean convention)
@@ -65,6 +67,7 @@ inline FitOptions paper_fit_options() {
   o.atlas.softplus_beta = 0;  // ReLU
   o.wrap_steps = 0;
   o.reseed_every = 0;
+  o.atlas.alpha = 0.01;
   o.points = 10000;
   return o;
 }
