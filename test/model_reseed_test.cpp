@@ -29,20 +29,35 @@ std::vector<double> heights(Atlas<float>& atlas) {
   return z;
 }
 
+// An atlas with K Gaussians wrapped outward around the unit sphere (model/wrap.h),
+// and its targets: `samples` points of the sphere, rows [x, alpha n].
+struct WrappedSphere {
+  WrappedSphere(int gaussians, Index samples, int wrap_steps) : atlas(options(gaussians)) {
+    Rng init(7);
+    atlas.initialize(init);
+    pool = sphere_pool(samples, 8).cast<float>();
+    pool.rightCols(3) *= float(atlas.options().alpha);
+    Rng wrap_rng(9);
+    wrap_initialize(atlas, {pool}, wrap_steps, 1000, 2e-3, wrap_rng);
+  }
+  static AtlasOptions options(int gaussians) {
+    AtlasOptions o;
+    o.gaussians = gaussians;
+    o.width = 32;
+    o.hidden_layers = 3;
+    return o;
+  }
+  Atlas<float> atlas;
+  Block<float> pool;
+};
+
 }  // namespace
 
 TEST_CASE("reseed_flipped_means: a flipped half's components move to the border of the other half", "[reseed]") {
-  AtlasOptions o;
-  o.gaussians = 1024;
-  o.width = 32;
-  o.hidden_layers = 3;
-  Atlas<float> atlas(o);
-  Rng init(7);
-  atlas.initialize(init);
-  Block<float> pool = sphere_pool(20000, 8).cast<float>();
-  pool.rightCols(3) *= float(o.alpha);
-  Rng wrap_rng(9);
-  wrap_initialize(atlas, {pool}, 800, 1000, 2e-3, wrap_rng);
+  WrappedSphere sphere(1024, 20000, 800);
+  Atlas<float>& atlas = sphere.atlas;
+  Block<float>& pool = sphere.pool;
+  const int K = atlas.options().gaussians;
   // The lower half's targets face inward.
   for (Index i = 0; i < pool.rows(); ++i)
     if (pool(i, 2) < 0) pool.row(i).rightCols(3) *= -1.0f;
@@ -53,7 +68,7 @@ TEST_CASE("reseed_flipped_means: a flipped half's components move to the border 
   Rng rng(3);
   const ReseedReport r = reseed_flipped_means(atlas, {pool}, {0}, rng, {&m, &v});
   const std::vector<double> z1 = heights(atlas);
-  INFO("moved " << r.flipped << " of " << o.gaussians << ", back-facing " << r.back_facing);
+  INFO("moved " << r.flipped << " of " << K << ", back-facing " << r.back_facing);
   // Half the sphere is flipped: about half the components, and of the samples.
   CHECK(r.back_facing > 0.4);
   CHECK(r.back_facing < 0.6);
@@ -98,17 +113,9 @@ TEST_CASE("reseed_flipped_means: a flipped half's components move to the border 
 }
 
 TEST_CASE("reseed_flipped_means: a correct atlas is left alone; the trainer's schedule", "[reseed]") {
-  AtlasOptions o;
-  o.gaussians = 256;
-  o.width = 32;
-  o.hidden_layers = 3;
-  Atlas<float> atlas(o);
-  Rng init(7);
-  atlas.initialize(init);
-  Block<float> pool = sphere_pool(5000, 8).cast<float>();
-  pool.rightCols(3) *= float(o.alpha);
-  Rng wrap_rng(9);
-  wrap_initialize(atlas, {pool}, 600, 1000, 2e-3, wrap_rng);
+  WrappedSphere sphere(256, 5000, 600);
+  Atlas<float>& atlas = sphere.atlas;
+  const Block<float>& pool = sphere.pool;
   const std::vector<float> before = atlas.params.values();
   Rng rng(3);
   const ReseedReport r = reseed_flipped_means(atlas, {pool}, {0}, rng, {});
@@ -125,10 +132,10 @@ TEST_CASE("reseed_flipped_means: a correct atlas is left alone; the trainer's sc
   f.iterations = 40;
   f.reseed_every = 10;
   // The lower half faces inward: a random start's sheet is wrong somewhere.
-  Block<double> sphere = sphere_pool(2000, 11);
-  for (Index i = 0; i < sphere.rows(); ++i)
-    if (sphere(i, 2) < 0) sphere.row(i).rightCols(3) *= -1.0;
-  Trainer a(f, sphere), b(f, sphere);
+  Block<double> half_inward = sphere_pool(2000, 11);
+  for (Index i = 0; i < half_inward.rows(); ++i)
+    if (half_inward(i, 2) < 0) half_inward.row(i).rightCols(3) *= -1.0;
+  Trainer a(f, half_inward), b(f, half_inward);
   for (int i = 0; i < 40; ++i) {
     a.step();
     b.step();
@@ -137,7 +144,7 @@ TEST_CASE("reseed_flipped_means: a correct atlas is left alone; the trainer's sc
   CHECK(a.reseeded() > 0);
   CHECK(a.reseeded() == b.reseeded());
   f.reseed_every = 0;
-  Trainer c(f, sphere);
+  Trainer c(f, half_inward);
   for (int i = 0; i < 40; ++i) c.step();
   CHECK(c.reseeded() == 0);
 }
