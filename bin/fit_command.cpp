@@ -85,6 +85,7 @@ void run_fit(FitArgs& a) {
       o.atlas.softplus_beta = paper.atlas.softplus_beta;
       o.wrap_steps = paper.wrap_steps;
       o.reseed_every = paper.reseed_every;
+      o.dense_surface = paper.dense_surface;
       o.atlas.alpha = paper.atlas.alpha;
     }
     if (a.table_row) o.components = Components::table_row(a.table_row);
@@ -271,12 +272,13 @@ void add_fit(CLI::App& app) {
   c->add_flag("--no-distribution", a->no_distribution, "Ablation: sample the Gaussian means only (a learned point set)");
   c->add_flag("--no-chart", a->no_chart, "Ablation: no chart psi, no L_2D, no L_cycle");
   c->add_flag("--no-isometry", a->no_isometry, "Ablation: no L_iso");
-  c->add_option("--preset", a->preset, "paper: M = K = 10^4, 5 x 256 ReLU MLPs, alpha 0.01, no wrap or reseed (slow on a laptop)");
+  c->add_option("--preset", a->preset, "paper: M = K = 10^4, 5 x 256 ReLU MLPs, alpha 0.01, no wrap, reseed or dense surface (slow on a laptop)");
   c->add_option("--pool", o.pool, "Surface samples drawn once from the input")->capture_default_str()->check(CLI::Range(Index(100), Index(10000000)));
   c->add_option("--repulsion-tolerance", o.repulsion_tolerance, "Bound on the error of L_rep from its cut-off radius")->capture_default_str()->check(CLI::Range(1e-15, 1e-2))->check(kFinite);
   c->add_option("--softplus", o.atlas.softplus_beta, "Activation of phi and psi: BETA > 0 softplus log(1 + e^(BETA z)) / BETA (smooth normals), 0 ReLU (the paper)")->capture_default_str()->check(CLI::Range(0.0, 1e6))->check(kFinite);
   c->add_option("--code-layer", o.atlas.code_layer, "Collections: where the codes enter phi and psi: 0 the input (concatenation), 1 after the first layer")->capture_default_str()->check(CLI::Range(0, 1));
   c->add_option("--reseed", o.reseed_every, "Every N steps before the first decay, move the Gaussians of back-facing flaps to the surface's holes (0: never, as the paper; see model/reseed.h)")->capture_default_str()->check(CLI::Range(0, 1000000));
+  c->add_flag("--dense-surface,!--no-dense-surface", o.dense_surface, "L_6D matches phi6(x_P) in the whole pool of surface samples, not only the step's M (sharper pull; see losses/chamfer.h)")->capture_default_str();
   c->add_option("--wrap", o.wrap_steps, "Steps fitting phi and psi to a closed ellipsoid around the shape before training (0: random start, as the paper; see model/wrap.h)")->capture_default_str()->check(CLI::Range(0, 1000000));
   c->add_option("--batch-shapes", o.batch_shapes, "Collections: shapes per iteration, a seeded random subset (0: all); the loss is scaled by N/B")->capture_default_str()->check(CLI::NonNegativeNumber);
   c->add_option("--orient-every", o.orient_every, "Choose phi's global orientation every N iterations until the first decay (0: never; see model/orientation.h)")->capture_default_str()->check(CLI::NonNegativeNumber);

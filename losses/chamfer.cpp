@@ -9,12 +9,17 @@ namespace jsa {
 namespace {
 
 // Fills m with both associations; returns CD(x, y), summed in double, in order.
+// x's matches are searched in `surface` when it is given (dense variant), else in y.
 template <class T>
-double match_both_ways(const Block<T>& x, const Block<T>& y, ChamferMatches<T>& m) {
+double match_both_ways(const Block<T>& x, const Block<T>& y, const NearestIndex<T>* surface,
+                       ChamferMatches<T>& m) {
   JSA_CHECK(x.rows() > 0 && y.rows() > 0,
             "chamfer of an empty set: " << x.rows() << " and " << y.rows() << " points");
   JSA_CHECK(x.cols() == y.cols(), "chamfer: " << x.cols() << " vs " << y.cols() << " columns");
-  nearest(x, y, m.x_to_y, &m.x_squared_distance);
+  if (surface)
+    surface->query(x, m.x_to_y, &m.x_squared_distance);
+  else
+    nearest(x, y, m.x_to_y, &m.x_squared_distance);
   nearest(y, x, m.y_to_x, &m.y_squared_distance);
   double sx = 0, sy = 0;
   for (T d : m.x_squared_distance) sx += double(d);
@@ -22,41 +27,35 @@ double match_both_ways(const Block<T>& x, const Block<T>& y, ChamferMatches<T>& 
   return sx / double(x.rows()) + sy / double(y.rows());
 }
 
-}  // namespace
-
-template <class T>
-double chamfer_distance(const Block<T>& x, const Block<T>& y, ChamferMatches<T>* matches) {
-  ChamferMatches<T> local;
-  return match_both_ways(x, y, matches ? *matches : local);
-}
-
-// L = 1/N sum_i |x_i - y_{a_i}|^2 + 1/M sum_j |y_j - x_{b_j}|^2, matches held fixed.
-// With r_i = x_i - y_{a_i} and s_j = y_j - x_{b_j}, and dL the incoming gradient:
-//   dx_i     += 2 dL/N r_i      dy_{a_i} -= 2 dL/N r_i
+// L = 1/N sum_i |x_i - z_{a_i}|^2 + 1/M sum_j |y_j - x_{b_j}|^2, matches held
+// fixed, where z = Y (Eq. 6) or the fixed pool S (dense variant, S constant).
+// With r_i = x_i - z_{a_i} and s_j = y_j - x_{b_j}, and dL the incoming gradient:
+//   dx_i     += 2 dL/N r_i      dy_{a_i} -= 2 dL/N r_i   (only when z = Y)
 //   dy_j     += 2 dL/M s_j      dx_{b_j} -= 2 dL/M s_j
 // The own-row terms write disjoint rows (parallel); the scatter-adds run serially
 // in index order, so the sums are the same for every thread count.
 template <class T>
-Var chamfer(Tape<T>& t, Var x, Var y, ChamferMatches<T>* matches) {
+Var chamfer_op(Tape<T>& t, Var x, Var y, const NearestIndex<T>* surface, ChamferMatches<T>* matches) {
   ChamferMatches<T> local;
   ChamferMatches<T>& m = matches ? *matches : local;
-  const double value = match_both_ways(t.value(x), t.value(y), m);
+  const double value = match_both_ways(t.value(x), t.value(y), surface, m);
   Var out = t.node(1, 1, {x, y});
   t.value(out)(0, 0) = T(value);
   if (!t.needs_grad(out)) return out;
 
   const int x_to_y = t.keep(m.x_to_y), y_to_x = t.keep(m.y_to_x);
-  t.on_backward(out, [x, y, x_to_y, y_to_x](Tape<T>& t, Var out) {
+  t.on_backward(out, [x, y, x_to_y, y_to_x, surface](Tape<T>& t, Var out) {
     const std::vector<int>& a = t.kept(x_to_y);
     const std::vector<int>& b = t.kept(y_to_x);
     const Block<T>& X = t.value(x);
     const Block<T>& Y = t.value(y);
+    const Block<T>& Z = surface ? surface->points() : Y;
     const T dL = t.grad(out)(0, 0);
     const T cx = T(2) * dL / T(X.rows()), cy = T(2) * dL / T(Y.rows());
     if (t.needs_grad(x)) {
       Block<T>& dX = t.grad(x);
       parallel_rows(X.rows(), [&](Index begin, Index end) {
-        for (Index i = begin; i < end; ++i) dX.row(i) += cx * (X.row(i) - Y.row(a[i]));
+        for (Index i = begin; i < end; ++i) dX.row(i) += cx * (X.row(i) - Z.row(a[i]));
       });
       for (Index j = 0; j < Y.rows(); ++j) dX.row(b[j]) -= cy * (Y.row(j) - X.row(b[j]));
     }
@@ -65,15 +64,35 @@ Var chamfer(Tape<T>& t, Var x, Var y, ChamferMatches<T>* matches) {
       parallel_rows(Y.rows(), [&](Index begin, Index end) {
         for (Index j = begin; j < end; ++j) dY.row(j) += cy * (Y.row(j) - X.row(b[j]));
       });
-      for (Index i = 0; i < X.rows(); ++i) dY.row(a[i]) -= cx * (X.row(i) - Y.row(a[i]));
+      if (!surface)
+        for (Index i = 0; i < X.rows(); ++i) dY.row(a[i]) -= cx * (X.row(i) - Y.row(a[i]));
     }
   });
   return out;
 }
 
+}  // namespace
+
+template <class T>
+double chamfer_distance(const Block<T>& x, const Block<T>& y, ChamferMatches<T>* matches) {
+  ChamferMatches<T> local;
+  return match_both_ways(x, y, static_cast<const NearestIndex<T>*>(nullptr), matches ? *matches : local);
+}
+
+template <class T>
+Var chamfer(Tape<T>& t, Var x, Var y, ChamferMatches<T>* matches) {
+  return chamfer_op(t, x, y, static_cast<const NearestIndex<T>*>(nullptr), matches);
+}
+
+template <class T>
+Var chamfer(Tape<T>& t, Var x, Var y, const NearestIndex<T>& surface, ChamferMatches<T>* matches) {
+  return chamfer_op(t, x, y, &surface, matches);
+}
+
 #define JSA_INSTANTIATE(T)                                         \
   template struct ChamferMatches<T>;                               \
   template Var chamfer<T>(Tape<T>&, Var, Var, ChamferMatches<T>*); \
+  template Var chamfer<T>(Tape<T>&, Var, Var, const NearestIndex<T>&, ChamferMatches<T>*); \
   template double chamfer_distance<T>(const Block<T>&, const Block<T>&, ChamferMatches<T>*);
 JSA_INSTANTIATE(float)
 JSA_INSTANTIATE(double)

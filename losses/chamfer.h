@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "engine/tape.h"
+#include "losses/nearest.h"
 
 namespace jsa {
 
@@ -29,6 +30,21 @@ struct ChamferMatches {
 // constant). If matches is given it is filled with the association.
 template <class T>
 Var chamfer(Tape<T>& t, Var x, Var y, ChamferMatches<T>* matches = nullptr);
+
+// The dense variant of L_6D: the x -> Y direction searches `surface`, a fixed
+// pool far larger than this step's M (all of the shape's samples, indexed once),
+// the Y -> x direction searches x as above:
+//
+//   CD_dense(X, Y) = 1/N sum_i min_{p in S} |x_i - p|^2  +  1/M sum_j min_i |y_j - x_i|^2
+//
+// Why: with M = 2500 samples a surface point's nearest target is about the
+// sample spacing away (~0.02 of the radius) in a random direction, so the
+// first term's pull is mostly noise; against 2 x 10^5 samples it points at
+// the surface itself, spacing ~0.005. The second term keeps its M targets:
+// it is the one that asks for coverage. The pool is a constant (no gradient);
+// matches->x_to_y then indexes surface.points().
+template <class T>
+Var chamfer(Tape<T>& t, Var x, Var y, const NearestIndex<T>& surface, ChamferMatches<T>* matches = nullptr);
 
 // The same value without a tape (evaluation). Sums accumulate in double.
 template <class T>

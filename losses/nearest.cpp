@@ -85,18 +85,23 @@ class ClosestOne {
 };
 
 template <class T, int Dim>
-void nearest_kdtree(const Block<T>& queries, const Block<T>& points, std::vector<int>& index,
-                    std::vector<T>* squared_distance) {
-  using Tree = nanoflann::KDTreeSingleIndexAdaptor<SquaredL2<T, Dim>, RowsSource<T>, Dim, uint32_t>;
-  const RowsSource<T> source{points.data(), size_t(points.rows()), size_t(points.cols())};
-  // Leaves of ~16 points: a leaf scan is a short, branch-light loop.
-  const Tree tree(points.cols(), source, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+using KdTree = nanoflann::KDTreeSingleIndexAdaptor<SquaredL2<T, Dim>, RowsSource<T>, Dim, uint32_t>;
+
+// Leaves of ~16 points: a leaf scan is a short, branch-light loop.
+template <class T, int Dim>
+std::unique_ptr<KdTree<T, Dim>> build_tree(const RowsSource<T>& source) {
+  return std::make_unique<KdTree<T, Dim>>(source.cols, source, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+}
+
+template <class T, int Dim>
+void query_tree(const KdTree<T, Dim>& tree, const Block<T>& queries, std::vector<int>& index,
+                std::vector<T>* squared_distance) {
   const nanoflann::SearchParams params;  // eps = 0: exact search
   const Index m = queries.rows();
   const T* q = queries.data();
   const size_t c = size_t(queries.cols());
   T* dist = squared_distance ? squared_distance->data() : nullptr;
-// Small batches stay serial: a parallel region costs more than it saves, and
+  // Small batches stay serial: a parallel region costs more than it saves, and
   // far more when another process holds the second core.
 #pragma omp parallel for schedule(dynamic, 256) if (m > 1024)
   for (Index i = 0; i < m; ++i) {
@@ -105,6 +110,13 @@ void nearest_kdtree(const Block<T>& queries, const Block<T>& points, std::vector
     index[i] = int(best.index());
     if (dist) dist[i] = best.distance();
   }
+}
+
+template <class T, int Dim>
+void nearest_kdtree(const Block<T>& queries, const Block<T>& points, std::vector<int>& index,
+                    std::vector<T>* squared_distance) {
+  const RowsSource<T> source{points.data(), size_t(points.rows()), size_t(points.cols())};
+  query_tree<T, Dim>(*build_tree<T, Dim>(source), queries, index, squared_distance);
 }
 
 template <class T>
@@ -136,6 +148,60 @@ void nearest(const Block<T>& queries, const Block<T>& points, std::vector<int>& 
   }
 }
 
+// NearestIndex: the points, and a tree over them whose column count is fixed
+// at compile time where nearest() fixes it.
+template <class T>
+struct NearestIndex<T>::Impl {
+  Block<T> points;
+  RowsSource<T> source;
+  explicit Impl(Block<T> p) : points(std::move(p)), source{points.data(), size_t(points.rows()), size_t(points.cols())} {}
+  virtual ~Impl() = default;
+  virtual void query(const Block<T>& q, std::vector<int>& index, std::vector<T>* d) const = 0;
+};
+
+namespace {
+template <class T, int Dim>
+struct TreeImpl final : NearestIndex<T>::Impl {
+  std::unique_ptr<KdTree<T, Dim>> tree;
+  explicit TreeImpl(Block<T> p) : NearestIndex<T>::Impl(std::move(p)), tree(build_tree<T, Dim>(this->source)) {}
+  void query(const Block<T>& q, std::vector<int>& index, std::vector<T>* d) const override {
+    query_tree<T, Dim>(*tree, q, index, d);
+  }
+};
+}  // namespace
+
+template <class T>
+NearestIndex<T>::NearestIndex(Block<T> points) {
+  check_shapes(points, points);
+  switch (points.cols()) {
+    case 2: impl_ = std::make_unique<TreeImpl<T, 2>>(std::move(points)); break;
+    case 3: impl_ = std::make_unique<TreeImpl<T, 3>>(std::move(points)); break;
+    case 6: impl_ = std::make_unique<TreeImpl<T, 6>>(std::move(points)); break;
+    default: impl_ = std::make_unique<TreeImpl<T, -1>>(std::move(points)); break;
+  }
+}
+
+template <class T>
+NearestIndex<T>::~NearestIndex() = default;
+template <class T>
+NearestIndex<T>::NearestIndex(NearestIndex&&) noexcept = default;
+template <class T>
+NearestIndex<T>& NearestIndex<T>::operator=(NearestIndex&&) noexcept = default;
+
+template <class T>
+void NearestIndex<T>::query(const Block<T>& queries, std::vector<int>& index,
+                            std::vector<T>* squared_distance) const {
+  check_shapes(queries, impl_->points);
+  index.resize(queries.rows());
+  if (squared_distance) squared_distance->resize(queries.rows());
+  impl_->query(queries, index, squared_distance);
+}
+
+template <class T>
+const Block<T>& NearestIndex<T>::points() const {
+  return impl_->points;
+}
+
 template <class T>
 void nearest_brute_force(const Block<T>& queries, const Block<T>& points, std::vector<int>& index,
                          std::vector<T>* squared_distance) {
@@ -164,7 +230,8 @@ void nearest_brute_force(const Block<T>& queries, const Block<T>& points, std::v
 #define JSA_INSTANTIATE(T)                                                                        \
   template void nearest<T>(const Block<T>&, const Block<T>&, std::vector<int>&, std::vector<T>*); \
   template void nearest_brute_force<T>(const Block<T>&, const Block<T>&, std::vector<int>&,       \
-                                       std::vector<T>*);
+                                       std::vector<T>*);       \
+  template class NearestIndex<T>;
 JSA_INSTANTIATE(float)
 JSA_INSTANTIATE(double)
 

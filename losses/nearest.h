@@ -8,6 +8,7 @@
 // Determinism: queries run in parallel, but each writes only its own slot, and the
 // tree is built serially, so results do not depend on the thread count.
 #pragma once
+#include <memory>
 #include <vector>
 
 #include "engine/block.h"
@@ -26,5 +27,26 @@ void nearest(const Block<T>& queries, const Block<T>& points, std::vector<int>& 
 template <class T>
 void nearest_brute_force(const Block<T>& queries, const Block<T>& points, std::vector<int>& index,
                          std::vector<T>* squared_distance = nullptr);
+
+// The same search against a point set that stays fixed over many calls (the
+// surface pool of L_6D's dense variant): the tree is built once, here, and
+// every query() reuses it. Same contract and tie rule as nearest().
+template <class T>
+class NearestIndex {
+ public:
+  explicit NearestIndex(Block<T> points);
+  ~NearestIndex();
+  NearestIndex(NearestIndex&&) noexcept;
+  NearestIndex& operator=(NearestIndex&&) noexcept;
+
+  void query(const Block<T>& queries, std::vector<int>& index,
+             std::vector<T>* squared_distance = nullptr) const;
+  const Block<T>& points() const;
+
+  struct Impl;  // the tree; defined in nearest.cpp, where nanoflann lives
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace jsa

@@ -75,6 +75,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["batch_shapes"] = o.batch_shapes;
   j["wrap_steps"] = o.wrap_steps;
   j["reseed_every"] = o.reseed_every;
+  j["dense_surface"] = o.dense_surface;
   j["pool"] = o.pool;
   j["threads"] = o.threads;
   return j.dump(indent);
@@ -140,6 +141,8 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (j.contains("wrap_steps")) field(j, "", "wrap_steps", o.wrap_steps);
   o.reseed_every = 0;
   if (j.contains("reseed_every")) field(j, "", "reseed_every", o.reseed_every);
+  o.dense_surface = false;
+  if (j.contains("dense_surface")) field(j, "", "dense_surface", o.dense_surface);
   field(j, "", "pool", o.pool);
   field(j, "", "threads", o.threads);
   if (o.atlas.gaussians <= 0 || o.atlas.width <= 0 || o.atlas.hidden_layers < 0 || o.points <= 0 ||

@@ -8,6 +8,7 @@
 // The paper's l_cycle = 1/M and l_iso = 1e-4/M are the same weights for losses
 // written as sums over the M points (the authors' code); see docs/method.md.
 #pragma once
+#include "losses/nearest.h"
 #include "model/atlas.h"
 
 namespace jsa {
@@ -46,10 +47,13 @@ struct ObjectiveOptions {
 
 // Builds L_single of shape `shape` (0 for a single shape) on the tape and returns
 // it (1 x 1). targets: rows [x_S, alpha n_S] sampled on the shape; `samples` 2D
-// points are drawn from P.
+// points are drawn from P. surface: if given, L_6D is the dense variant (see
+// losses/chamfer.h) against this index over the shape's whole pool, rows
+// [x_S, alpha n_S] (or [x_S] when the normals are off).
 template <class T>
 Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T>& targets,
-                           Index samples, Rng& rng, const ObjectiveOptions& o, LossTerms* terms);
+                           Index samples, Rng& rng, const ObjectiveOptions& o, LossTerms* terms,
+                           const NearestIndex<T>* surface = nullptr);
 
 // L_full, Eq. (12): sum over the shapes of L_single. L_rep depends on mu alone,
 // so it is computed once and counted N times (as the sum does); a collection
@@ -58,9 +62,11 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
 // batch: the shapes targets[b] belong to, when a step uses a subset of B of the
 // N shapes (empty: all, in order). The subset's sum is scaled by N / B, so that
 // over a uniformly drawn subset its expectation is the full sum of Eq. (12).
+// surfaces: empty, or one index per shape of the atlas (dense L_6D).
 template <class T>
 Var collection_objective(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>>& targets,
                          Index samples, Rng& rng, const ObjectiveOptions& o, LossTerms* terms,
-                         const std::vector<int>& batch = {});
+                         const std::vector<int>& batch = {},
+                         const std::vector<NearestIndex<T>>& surfaces = {});
 
 }  // namespace jsa

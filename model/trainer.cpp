@@ -21,6 +21,8 @@ Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools)
     JSA_CHECK(pool.cols() == 6 && pool.rows() > 0, "a target pool must be P x 6");
     pools_.push_back(pool.cast<float>());
     pools_.back().rightCols(3) *= float(o.atlas.alpha);
+    if (o.dense_surface)
+      surfaces_.emplace_back(o.components.normals ? pools_.back() : Block<float>(pools_.back().leftCols(3)));
   }
   const int n = int(pools.size());
   const int b = o.batch_shapes > 0 && o.batch_shapes < n ? o.batch_shapes : n;
@@ -73,7 +75,7 @@ void Trainer::step() {
   tape_.clear();
   const ObjectiveOptions objective{options_.weights, options_.components, options_.repulsion_tolerance};
   Var loss = collection_objective(tape_, *atlas_, targets_, options_.points, rng_, objective, &last_,
-                                  b < n ? batch_ : std::vector<int>{});
+                                  b < n ? batch_ : std::vector<int>{}, surfaces_);
   atlas_->params.zero_grad();
   tape_.backward(loss);
   if (iteration_ == fault_at_ && faults_to_inject_ > 0) {

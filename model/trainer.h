@@ -56,6 +56,9 @@ struct FitOptions {
   // of back-facing flaps to the holes of the surface (model/reseed.h); 0: never.
   // Only with normals in the loss and the distribution P (Table 1 rows 9-11).
   int reseed_every = 0;
+  // L_6D's dense variant (losses/chamfer.h): phi6(x_P) is matched in the whole
+  // pool instead of the step's M targets; the targets' direction is unchanged.
+  bool dense_surface = false;
 };
 
 // The paper's configuration (Sec. 3, implementation details).
@@ -67,6 +70,7 @@ inline FitOptions paper_fit_options() {
   o.atlas.softplus_beta = 0;  // ReLU
   o.wrap_steps = 0;
   o.reseed_every = 0;
+  o.dense_surface = false;
   o.atlas.alpha = 0.01;
   o.points = 10000;
   return o;
@@ -104,8 +108,8 @@ class Trainer {
   WrapReport wrap(const std::function<bool()>& cancelled = {});
   double learning_rate() const;  // the schedule at the current iteration, times the fault scale
   int faults() const { return faults_total_; }
-  int mirrors() const { return mirrors_; }
-  int reseeded() const { return reseeded_; }  // Gaussians moved so far (model/reseed.h)  // times the domain was mirrored (model/orientation.h)
+  int mirrors() const { return mirrors_; }  // times the domain was mirrored (model/orientation.h)
+  int reseeded() const { return reseeded_; }  // Gaussians moved so far (model/reseed.h)
   // Test hook: the next `count` attempts at `iteration` see a NaN loss.
   void inject_faults(int64_t iteration, int count) {
     fault_at_ = iteration;
@@ -127,6 +131,7 @@ class Trainer {
  private:
   FitOptions options_;
   std::vector<Block<float>> pools_;  // per shape P x 6, normals scaled by alpha
+  std::vector<NearestIndex<float>> surfaces_;  // per shape, over its pool (dense L_6D only)
   std::unique_ptr<Atlas<float>> atlas_;
   Adam<float> adam_;
   Tape<float> tape_;

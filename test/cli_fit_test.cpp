@@ -158,6 +158,18 @@ TEST_CASE("cli: moving flipped Gaussians is reported and saved", "[cli]") {
   CHECK(run("fit builtin:sphere -o " + dir + "_bad --reseed -1" + kSmall).code == 2);
 }
 
+TEST_CASE("cli: the dense surface flag is saved, and its negation turns it off", "[cli]") {
+  const std::string dir = fresh_dir("dense");
+  Result r = run("fit builtin:sphere -o " + dir + " --iters 5 --dense-surface" + kSmall);
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  CHECK(read_text(dir + "/config.json").find("\"dense_surface\": true") != std::string::npos);
+  r = run("fit builtin:sphere -o " + dir + "_off --iters 5 --no-dense-surface" + kSmall);
+  REQUIRE(r.code == 0);
+  CHECK(read_text(dir + "_off/config.json").find("\"dense_surface\": false") != std::string::npos);
+  CHECK(run("fit builtin:sphere -o " + dir + "_bad --dense-surface=maybe" + kSmall).code == 2);
+}
+
 TEST_CASE("cli: the starting wrap is reported, and Ctrl-C during it writes no checkpoint", "[cli]") {
   const std::string dir = fresh_dir("wrap");
   Result r = run("fit builtin:capsule -o " + dir + " --iters 5 --wrap 30" +

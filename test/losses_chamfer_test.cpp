@@ -187,6 +187,46 @@ TEST_CASE("chamfer gradients do not depend on the thread count", "[chamfer]") {
   CHECK(one.second == two.second);
 }
 
+TEST_CASE("dense chamfer: x searches the pool, y searches x", "[chamfer]") {
+  // Value: 1/N sum_i min over the pool + 1/M sum_j min over x, by double loops.
+  for (Index c : {3, 6}) {
+    const Block<double> x = random_block(120, c, 800 + c), y = random_block(90, c, 810 + c);
+    const Block<double> pool = random_block(2000, c, 820 + c);
+    const NearestIndex<double> surface(pool);
+    const double expected = one_way(x, pool) + one_way(y, x);
+    Tape<double> t;
+    ChamferMatches<double> m;
+    Var loss = chamfer(t, t.constant(x), t.constant(y), surface, &m);
+    CHECK(t.scalar(loss) == Approx(expected).epsilon(1e-12));
+    // The pool is far denser than y, so the dense first term is smaller.
+    CHECK(one_way(x, pool) < one_way(x, y));
+    for (Index i = 0; i < x.rows(); ++i)
+      CHECK(m.x_squared_distance[size_t(i)] == Approx((x.row(i) - pool.row(m.x_to_y[size_t(i)])).squaredNorm()));
+  }
+  // When the pool is y itself, the dense op is Eq. (6) exactly, gradients too.
+  const Block<double> x = random_block(60, 6, 830), y = random_block(50, 6, 831);
+  const NearestIndex<double> same(y);
+  Tape<double> t1, t2;
+  Var x1 = t1.variable(x), x2 = t2.variable(x);
+  t1.backward(chamfer(t1, x1, t1.constant(y)));
+  t2.backward(chamfer(t2, x2, t2.constant(y), same));
+  CHECK((t1.grad(x1) - t2.grad(x2)).cwiseAbs().maxCoeff() < 1e-14);
+}
+
+TEST_CASE("dense chamfer gradient passes the finite-difference check", "[chamfer]") {
+  // x and y are variables, the pool a constant: dL/dy has only the own-row
+  // term (y's matches in x), dL/dx both. Matches are stable (general position).
+  const Block<double> x = random_block(40, 6, 840), y = random_block(30, 6, 841);
+  const Block<double> pool = random_block(500, 6, 842);
+  REQUIRE(smallest_match_gap(x, pool) > 1e-4);
+  REQUIRE(smallest_match_gap(y, x) > 1e-4);
+  const NearestIndex<double> surface(pool);
+  const GradCheckResult r = check_gradients(
+      [&](Tape<double>& t, const std::vector<Var>& v) { return chamfer(t, v[0], v[1], surface); }, {x, y});
+  INFO(r.report);
+  CHECK(r.ok);
+}
+
 TEST_CASE("chamfer timing at training-loop sizes", "[.bench][chamfer]") {
   // L_6D shape: 10^4 x 10^4 points in 6 columns, float, forward + backward:
   // xyz in a cube, the last three columns scaled to ~0.01 like the normals.

@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <cstdio>
+#include <limits>
 
 #include "engine/parallel.h"
 #include "engine/rng.h"
@@ -67,6 +68,43 @@ TEMPLATE_TEST_CASE("nearest matches brute force in 2, 3, 5 and 6 columns", "[nea
   // queries far outside the points' bounding box
   expect_same_as_brute_force(random_block<TestType>(200, 2, 5, 10.0),
                              random_block<TestType>(300, 2, 6));
+}
+
+TEMPLATE_TEST_CASE("a NearestIndex built once answers like nearest() on every query", "[nearest]", float,
+                   double) {
+  for (Index c : {2, 3, 5, 6}) {
+    INFO("columns " << c);
+    const Block<TestType> points = c == 6 ? points_with_normals<TestType>(1500, 20)
+                                          : random_block<TestType>(1500, c, 21 + c);
+    const NearestIndex<TestType> index(points);
+    CHECK(index.points() == points);
+    // Several query sets against the one tree, each checked against the oracle.
+    for (uint64_t round = 0; round < 3; ++round) {
+      const Block<TestType> q = c == 6 ? points_with_normals<TestType>(400, 30 + round)
+                                       : random_block<TestType>(400, c, 40 + round, 1.5);
+      std::vector<int> got, oracle;
+      std::vector<TestType> dist, oracle_dist;
+      index.query(q, got, &dist);
+      nearest_brute_force(q, points, oracle, &oracle_dist);
+      REQUIRE(got.size() == size_t(q.rows()));
+      CHECK(got == oracle);
+      for (Index i = 0; i < q.rows(); ++i) CHECK(dist[i] == Approx(oracle_dist[i]).epsilon(1e-5).margin(1e-12));
+    }
+  }
+  // Moving the index keeps the tree valid (it points into the moved-from storage).
+  NearestIndex<TestType> a(random_block<TestType>(300, 3, 50));
+  const Block<TestType> q = random_block<TestType>(100, 3, 51);
+  std::vector<int> before, after;
+  a.query(q, before);
+  NearestIndex<TestType> b(std::move(a));
+  b.query(q, after);
+  CHECK(before == after);
+  // Bad queries are refused, as by nearest().
+  std::vector<int> idx;
+  CHECK_THROWS(b.query(random_block<TestType>(5, 2, 52), idx));
+  Block<TestType> nan_q = random_block<TestType>(5, 3, 53);
+  nan_q(2, 1) = std::numeric_limits<TestType>::quiet_NaN();
+  CHECK_THROWS(b.query(nan_q, idx));
 }
 
 TEMPLATE_TEST_CASE("nearest of the points themselves is themselves", "[nearest]", float, double) {

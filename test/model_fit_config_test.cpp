@@ -40,17 +40,19 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   o.batch_shapes = 3;
   o.wrap_steps = 40;
   o.reseed_every = 60;
+  o.dense_surface = true;
   o.atlas.softplus_beta = 7.5;
   const jsa::FitOptions back = jsa::fit_options_from_json(jsa::fit_options_to_json(o), "x");
   CHECK(back.orient_every == 25);
   CHECK(back.batch_shapes == 3);
   CHECK(back.wrap_steps == 40);
   CHECK(back.reseed_every == 60);
+  CHECK(back.dense_surface);
   CHECK(back.atlas.softplus_beta == 7.5);
   // A checkpoint written before these existed: no orientation check, no
   // batching, no wrap, ReLU.
   std::string old = jsa::fit_options_to_json(o, -1);
-  for (const std::string key : {"\"orient_every\":25,", "\"batch_shapes\":3,", ",\"wrap_steps\":40", ",\"reseed_every\":60",
+  for (const std::string key : {"\"orient_every\":25,", "\"batch_shapes\":3,", ",\"wrap_steps\":40", ",\"reseed_every\":60", ",\"dense_surface\":true",
                                 "\"softplus_beta\":7.5,"}) {
     const auto at = old.find(key);
     REQUIRE(at != std::string::npos);
@@ -61,6 +63,7 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   CHECK(legacy.batch_shapes == 0);
   CHECK(legacy.wrap_steps == 0);
   CHECK(legacy.reseed_every == 0);
+  CHECK(!legacy.dense_surface);
   CHECK(legacy.atlas.softplus_beta == 0);
   CHECK(message_of(edited("\"batch_shapes\":0", "\"batch_shapes\":-2")) == "run/model.ckpt: sizes must be positive");
 }

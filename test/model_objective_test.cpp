@@ -164,3 +164,66 @@ TEST_CASE("objective: a batch of B of N shapes is their sum scaled by N / B", "[
   Rng r3(11);
   CHECK_THROWS_AS(collection_objective(tape, atlas, {t2, t0}, 24, r3, o, nullptr, {2, 3}), InternalError);
 }
+
+TEST_CASE("objective: dense L_6D equals Eq. 7 when the pool is the step's targets, and is differentiable",
+          "[objective]") {
+  AtlasOptions ao;
+  ao.gaussians = 16;
+  ao.width = 8;
+  ao.hidden_layers = 2;
+  Atlas<double> atlas(ao);
+  Rng init(12);
+  atlas.initialize(init);
+  const Block<double> targets = random_targets(24, ao.alpha, 13);
+  ObjectiveOptions o;
+  auto run = [&](const std::vector<NearestIndex<double>>& surfaces, LossTerms& terms) {
+    Tape<double> tape;
+    Rng rng(14);
+    Var loss = collection_objective(tape, atlas, {targets}, 24, rng, o, &terms, {}, surfaces);
+    atlas.params.zero_grad();
+    tape.backward(loss);
+    return atlas.params.grads();
+  };
+  LossTerms sparse_terms, same_terms, dense_terms;
+  const std::vector<double> g_sparse = run({}, sparse_terms);
+  std::vector<NearestIndex<double>> same;
+  same.emplace_back(targets);
+  const std::vector<double> g_same = run(same, same_terms);
+  CHECK(same_terms.total == Approx(sparse_terms.total).epsilon(1e-12));
+  double worst = 0;
+  for (size_t i = 0; i < g_sparse.size(); ++i) worst = std::max(worst, std::abs(g_sparse[i] - g_same[i]));
+  CHECK(worst < 1e-12);
+
+  // A pool 20 times denser on the same sphere: the x_P side finds closer matches.
+  std::vector<NearestIndex<double>> dense;
+  dense.emplace_back(random_targets(480, ao.alpha, 15));
+  run(dense, dense_terms);
+  CHECK(dense_terms.surface < sparse_terms.surface);
+  CHECK(dense_terms.chart == Approx(sparse_terms.chart).epsilon(1e-12));  // L_2D does not see the pool
+
+  // Central differences of the dense objective on every 7th parameter.
+  const std::vector<double> analytic = run(dense, dense_terms);
+  auto value = [&]() {
+    Tape<double> tape;
+    Rng rng(14);
+    return tape.scalar(collection_objective(tape, atlas, {targets}, 24, rng, o, nullptr, {}, dense));
+  };
+  double worst_fd = 0;
+  int checked = 0;
+  for (size_t i = 0; i < analytic.size(); i += 7) {
+    double& x = atlas.params.values()[i];
+    const double x0 = x, h = 1e-6 * std::max(1.0, std::abs(x0));
+    x = x0 + h;
+    const double lp = value();
+    x = x0 - h;
+    const double lm = value();
+    x = x0;
+    const double num = (lp - lm) / (2 * h);
+    worst_fd = std::max(worst_fd, std::abs(num - analytic[i]) /
+                                      (1e-7 + 1e-4 * std::max(std::abs(num), std::abs(analytic[i]))));
+    ++checked;
+  }
+  INFO(checked << " entries, worst error/tolerance " << worst_fd);
+  CHECK(checked > 30);
+  CHECK(worst_fd <= 1.0);
+}

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "engine/parallel.h"
+#include "model/domain_mesh.h"
 #include "model/trainer.h"
 #include "test/sphere_pool.h"
 
@@ -118,4 +119,33 @@ TEST_CASE("trainer: repeated faults stop with NumericalFault", "[trainer]") {
   CHECK_THROWS_AS(t.step(), NumericalFault);  // the fourth in a row gives up
   CHECK(t.iteration() == 1);
   for (float v : t.atlas().params.values()) REQUIRE(std::isfinite(v));
+}
+
+TEST_CASE("trainer: dense L_6D is seeded and learns the unit sphere", "[trainer]") {
+  const Block<double> pool = sphere_pool(20000, 3);
+  FitOptions o = small_options();
+  o.dense_surface = true;
+  Trainer a(o, pool), b(o, pool);
+  a.step();
+  b.step();
+  REQUIRE(a.last().total == b.last().total);
+  const double initial = a.last().surface;
+  while (!a.finished()) a.step();
+  INFO("dense L_6D after 400 iterations " << a.last().surface << ", initial " << initial);
+  CHECK(a.last().surface < 0.1 * initial);
+  // The surface itself: samples of P mapped by phi lie near the unit sphere
+  // with outward normals.
+  const Block<double> uv = a.atlas().params.value(a.atlas().domain.means()).cast<double>();
+  Block<double> points, normals;
+  evaluate_surface(a.atlas(), uv, points, normals, 0);
+  double radial = 0, facing = 0;
+  for (Index i = 0; i < points.rows(); ++i) {
+    radial += std::abs(points.row(i).norm() - 1.0);
+    facing += normals.row(i).dot(points.row(i).normalized());
+  }
+  radial /= double(points.rows());
+  facing /= double(points.rows());
+  INFO("mean | |phi(mu)| - 1 | = " << radial << ", mean n . x = " << facing);
+  CHECK(radial < 0.05);
+  CHECK(facing > 0.9);
 }
