@@ -37,6 +37,32 @@ double objective_value(Atlas<double>& atlas, const std::vector<Block<double>>& t
   return tape.scalar(loss);
 }
 
+// Central differences of value() at parameters first, first + stride, ... < end
+// (value must re-evaluate the whole objective), against analytic: adds to
+// `checked` and returns the worst |numeric - analytic| over its tolerance,
+// 1e-7 + 1e-4 max(|numeric|, |analytic|). Small steps keep nearest-neighbour
+// matches and ReLU patterns unchanged (random inputs are in general position,
+// so ties and kinks are measure-zero events).
+template <class Value>
+double worst_central_difference(Atlas<double>& atlas, const std::vector<double>& analytic, size_t first,
+                                size_t end, size_t stride, Value value, int& checked) {
+  double worst = 0;
+  for (size_t i = first; i < end; i += stride) {
+    double& x = atlas.params.values()[i];
+    const double x0 = x, h = 1e-6 * std::max(1.0, std::abs(x0));
+    x = x0 + h;
+    const double lp = value();
+    x = x0 - h;
+    const double lm = value();
+    x = x0;
+    const double num = (lp - lm) / (2 * h);
+    worst = std::max(worst, std::abs(num - analytic[i]) /
+                                (1e-7 + 1e-4 * std::max(std::abs(num), std::abs(analytic[i]))));
+    ++checked;
+  }
+  return worst;
+}
+
 }  // namespace
 
 TEST_CASE("objective: gradients of L_single match central differences", "[objective]") {
@@ -55,24 +81,11 @@ TEST_CASE("objective: gradients of L_single match central differences", "[object
     Tape<double> tape;
     objective_value(atlas, targets, c, tape, true);
     const std::vector<double> analytic = atlas.params.grads();
-    // Central differences on a fixed subset of entries (every 7th): small steps
-    // keep nearest-neighbour matches and ReLU patterns unchanged (random inputs
-    // are in general position, so ties and kinks are measure-zero events).
-    double worst = 0;
+    // Central differences on a fixed subset of entries (every 7th).
     int checked = 0;
-    for (size_t i = 0; i < analytic.size(); i += 7) {
-      double& x = atlas.params.values()[i];
-      const double x0 = x, h = 1e-6 * std::max(1.0, std::abs(x0));
-      x = x0 + h;
-      const double lp = objective_value(atlas, targets, c, tape, false);
-      x = x0 - h;
-      const double lm = objective_value(atlas, targets, c, tape, false);
-      x = x0;
-      const double num = (lp - lm) / (2 * h);
-      const double err = std::abs(num - analytic[i]) / (1e-7 + 1e-4 * std::max(std::abs(num), std::abs(analytic[i])));
-      worst = std::max(worst, err);
-      ++checked;
-    }
+    const double worst = worst_central_difference(
+        atlas, analytic, 0, analytic.size(), 7, [&]() { return objective_value(atlas, targets, c, tape, false); },
+        checked);
     INFO("Table 1 row " << row << ": " << checked << " entries, worst error/tolerance " << worst);
     CHECK(checked > 30);
     CHECK(worst <= 1.0);
@@ -105,19 +118,9 @@ TEST_CASE("objective: gradients of L_full for a collection (latent codes) match 
   int checked = 0;
   for (const char* name : {"codes.phi", "codes.psi", "phi.wf", "psi.wf", "domain.mu", "phi.w0"}) {
     const auto& e = atlas.params.entry(atlas.params.find(name));
-    for (size_t i = e.offset; i < e.offset + size_t(e.rows * e.cols); i += 3) {
-      double& x = atlas.params.values()[i];
-      const double x0 = x, h = 1e-6 * std::max(1.0, std::abs(x0));
-      x = x0 + h;
-      const double lp = objective_value(atlas, targets, c, tape, false);
-      x = x0 - h;
-      const double lm = objective_value(atlas, targets, c, tape, false);
-      x = x0;
-      const double num = (lp - lm) / (2 * h);
-      worst = std::max(worst, std::abs(num - analytic[i]) /
-                                  (1e-7 + 1e-4 * std::max(std::abs(num), std::abs(analytic[i]))));
-      ++checked;
-    }
+    worst = std::max(worst, worst_central_difference(
+                                atlas, analytic, e.offset, e.offset + size_t(e.rows * e.cols), 3,
+                                [&]() { return objective_value(atlas, targets, c, tape, false); }, checked));
   }
   INFO(checked << " entries, worst error/tolerance " << worst);
   CHECK(checked > 40);
@@ -208,21 +211,8 @@ TEST_CASE("objective: dense L_6D equals Eq. 7 when the pool is the step's target
     Rng rng(14);
     return tape.scalar(collection_objective(tape, atlas, {targets}, 24, rng, o, nullptr, {}, dense));
   };
-  double worst_fd = 0;
   int checked = 0;
-  for (size_t i = 0; i < analytic.size(); i += 7) {
-    double& x = atlas.params.values()[i];
-    const double x0 = x, h = 1e-6 * std::max(1.0, std::abs(x0));
-    x = x0 + h;
-    const double lp = value();
-    x = x0 - h;
-    const double lm = value();
-    x = x0;
-    const double num = (lp - lm) / (2 * h);
-    worst_fd = std::max(worst_fd, std::abs(num - analytic[i]) /
-                                      (1e-7 + 1e-4 * std::max(std::abs(num), std::abs(analytic[i]))));
-    ++checked;
-  }
+  const double worst_fd = worst_central_difference(atlas, analytic, 0, analytic.size(), 7, value, checked);
   INFO(checked << " entries, worst error/tolerance " << worst_fd);
   CHECK(checked > 30);
   CHECK(worst_fd <= 1.0);
