@@ -12,6 +12,16 @@ using namespace jsa;
 
 namespace {
 
+// An atlas small enough for central differences over every parameter subset:
+// 16 Gaussians, phi and psi with 2 hidden layers of 8.
+AtlasOptions small_atlas_options() {
+  AtlasOptions ao;
+  ao.gaussians = 16;
+  ao.width = 8;
+  ao.hidden_layers = 2;
+  return ao;
+}
+
 Block<double> random_targets(Index n, double alpha, uint64_t seed) {
   Rng rng(seed);
   Block<double> t(n, 6);
@@ -67,10 +77,7 @@ double worst_central_difference(Atlas<double>& atlas, const std::vector<double>&
 
 TEST_CASE("objective: gradients of L_single match central differences", "[objective]") {
   for (int row : {6, 7, 8, 9, 10, 11}) {
-    AtlasOptions ao;
-    ao.gaussians = 16;
-    ao.width = 8;
-    ao.hidden_layers = 2;
+    AtlasOptions ao = small_atlas_options();
     Components c = Components::table_row(row);
     ao.gaussian_noise = c.distribution;
     Atlas<double> atlas(ao);
@@ -93,10 +100,7 @@ TEST_CASE("objective: gradients of L_single match central differences", "[object
 }
 
 TEST_CASE("objective: gradients of L_full for a collection (latent codes) match central differences", "[objective]") {
-  AtlasOptions ao;
-  ao.gaussians = 16;
-  ao.width = 8;
-  ao.hidden_layers = 2;
+  AtlasOptions ao = small_atlas_options();
   ao.shapes = 2;
   ao.code_size = 4;
   ao.code_layer = GENERATE(0, 1);  // codes at the input, and after the first layer
@@ -142,10 +146,7 @@ TEST_CASE("objective: ablation rows switch the terms on one by one", "[objective
 }
 
 TEST_CASE("objective: a batch of B of N shapes is their sum scaled by N / B", "[objective]") {
-  AtlasOptions ao;
-  ao.gaussians = 16;
-  ao.width = 8;
-  ao.hidden_layers = 2;
+  AtlasOptions ao = small_atlas_options();
   ao.shapes = 3;
   ao.code_size = 4;
   Atlas<double> atlas(ao);
@@ -170,10 +171,7 @@ TEST_CASE("objective: a batch of B of N shapes is their sum scaled by N / B", "[
 
 TEST_CASE("objective: dense L_6D equals Eq. 7 when the pool is the step's targets, and is differentiable",
           "[objective]") {
-  AtlasOptions ao;
-  ao.gaussians = 16;
-  ao.width = 8;
-  ao.hidden_layers = 2;
+  AtlasOptions ao = small_atlas_options();
   Atlas<double> atlas(ao);
   Rng init(12);
   atlas.initialize(init);
