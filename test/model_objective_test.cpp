@@ -7,30 +7,18 @@
 
 #include "engine/ops.h"
 #include "model/objective.h"
+#include "test/small_atlas.h"
+#include "test/sphere_pool.h"
 
 using namespace jsa;
 
 namespace {
 
-// An atlas small enough for central differences over every parameter subset:
-// 16 Gaussians, phi and psi with 2 hidden layers of 8.
-AtlasOptions small_atlas_options() {
-  AtlasOptions ao;
-  ao.gaussians = 16;
-  ao.width = 8;
-  ao.hidden_layers = 2;
-  return ao;
-}
+AtlasOptions small_atlas_options() { return test_support::small_atlas(8); }
 
+// Points on the unit sphere with their normals (= positions) scaled to alpha.
 Block<double> random_targets(Index n, double alpha, uint64_t seed) {
-  Rng rng(seed);
-  Block<double> t(n, 6);
-  for (Index i = 0; i < n; ++i) {
-    Eigen::RowVector3d p(rng.normal(), rng.normal(), rng.normal());
-    p.normalize();  // points on the unit sphere, normals = positions
-    t.row(i) << p, alpha * p;
-  }
-  return t;
+  return test_support::sphere_pool(n, seed, alpha);
 }
 
 double objective_value(Atlas<double>& atlas, const std::vector<Block<double>>& targets, const Components& c,

@@ -8,23 +8,16 @@
 #include "engine/ops.h"
 #include "model/orientation.h"
 #include "model/trainer.h"
+#include "test/small_atlas.h"
 #include "test/sphere_pool.h"
 
 using namespace jsa;
 using test_support::sphere_pool;
 
 namespace {
-
-AtlasOptions small_atlas() {
-  AtlasOptions o;
-  o.gaussians = 16;
-  o.width = 12;
-  o.hidden_layers = 2;
-  return o;
-}
-
-
+AtlasOptions small_atlas() { return test_support::small_atlas(12); }
 }  // namespace
+
 
 TEST_CASE("mirror_domain: the same surface with negated normals; psi stays consistent", "[orientation]") {
   Atlas<double> atlas(small_atlas());
