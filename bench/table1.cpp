@@ -448,6 +448,7 @@ int main(int argc, char** argv) {
   a.fit.atlas.alpha = 0.01;
   a.fit.dense_surface = false;
   a.fit.reseed_every = 0;
+  a.fit.weights.cycle = jsa::LossWeights{}.cycle;  // and its lambda_cycle
   CLI::App app{
       "Table 1 of Learning Joint Surface Atlases for one category: AtlasNet baselines (rows 1-4) "
       "and the "

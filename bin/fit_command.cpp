@@ -77,16 +77,7 @@ void run_fit(FitArgs& a) {
     if (a.out_dir.empty()) throw InputError("fit: give an output directory with -o DIR");
     if (!a.preset.empty()) {
       if (a.preset != "paper") throw InputError("--preset: unknown preset '" + a.preset + "' (known: paper)");
-      const FitOptions paper = paper_fit_options();
-      o.points = paper.points;
-      o.atlas.gaussians = paper.atlas.gaussians;
-      o.atlas.width = paper.atlas.width;
-      o.atlas.hidden_layers = paper.atlas.hidden_layers;
-      o.atlas.softplus_beta = paper.atlas.softplus_beta;
-      o.wrap_steps = paper.wrap_steps;
-      o.reseed_every = paper.reseed_every;
-      o.dense_surface = paper.dense_surface;
-      o.atlas.alpha = paper.atlas.alpha;
+      apply_paper_preset(o);
     }
     if (a.table_row) o.components = Components::table_row(a.table_row);
     if (a.no_normals) o.components.normals = false;
@@ -272,7 +263,7 @@ void add_fit(CLI::App& app) {
   c->add_flag("--no-distribution", a->no_distribution, "Ablation: sample the Gaussian means only (a learned point set)");
   c->add_flag("--no-chart", a->no_chart, "Ablation: no chart psi, no L_2D, no L_cycle");
   c->add_flag("--no-isometry", a->no_isometry, "Ablation: no L_iso");
-  c->add_option("--preset", a->preset, "paper: M = K = 10^4, 5 x 256 ReLU MLPs, alpha 0.01, no wrap, reseed or dense surface (slow on a laptop)");
+  c->add_option("--preset", a->preset, "paper: M = K = 10^4, 5 x 256 ReLU MLPs, alpha 0.01, lambda_cycle 1, no wrap, reseed or dense surface (slow on a laptop; these win over the same settings' flags)");
   c->add_option("--pool", o.pool, "Surface samples drawn once from the input")->capture_default_str()->check(CLI::Range(Index(100), Index(10000000)));
   c->add_option("--repulsion-tolerance", o.repulsion_tolerance, "Bound on the error of L_rep from its cut-off radius")->capture_default_str()->check(CLI::Range(1e-15, 1e-2))->check(kFinite);
   c->add_option("--softplus", o.atlas.softplus_beta, "Activation of phi and psi: BETA > 0 softplus log(1 + e^(BETA z)) / BETA (smooth normals), 0 ReLU (the paper)")->capture_default_str()->check(CLI::Range(0.0, 1e6))->check(kFinite);

@@ -4,7 +4,8 @@
 // ablation (Table 1 rows 6-11).
 //
 // Convention: every term is a MEAN over its points (as Eqs. 6-10 write them),
-// so the weights are l_6D = 1, l_2D = 1e-2, l_cycle = 1, l_iso = 1e-4, l_rep = 1.
+// so the paper's weights are l_6D = 1, l_2D = 1e-2, l_cycle = 1, l_iso = 1e-4,
+// l_rep = 1 (LossWeights' defaults; `jsatlas fit` lowers l_cycle, model/trainer.h).
 // The paper's l_cycle = 1/M and l_iso = 1e-4/M are the same weights for losses
 // written as sums over the M points (the authors' code); see docs/method.md.
 #pragma once
@@ -16,7 +17,7 @@ namespace jsa {
 struct LossWeights {
   double surface = 1.0;     // l_6D, on L_6D (Eq. 7)
   double chart = 1e-2;      // l_2D, on L_2D (Eq. 8)
-  double cycle = 1.0;       // l_cycle, on L_cycle (Eq. 9), mean convention
+  double cycle = 1.0;       // l_cycle, on L_cycle (Eq. 9), mean convention (FitOptions: 0.1)
   double isometry = 1e-4;   // l_iso, on L_iso (Eq. 10), mean convention
   double repulsion = 1.0;   // l_rep, on L_rep (Eq. 11)
   double code = 1e-4;       // collections: weight of the mean squared norm of the latent codes

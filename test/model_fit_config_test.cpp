@@ -34,6 +34,29 @@ TEST_CASE("fit config: the defaults round-trip through JSON", "[fit_config]") {
   CHECK(o.seed == jsa::FitOptions().seed);
 }
 
+TEST_CASE("fit config: the paper preset restores the paper's lambdas and keeps the run's own settings",
+          "[fit_config]") {
+  jsa::FitOptions o;
+  REQUIRE(o.weights.cycle == 0.1);  // the laptop default (docs/method.md, "lambda_cycle")
+  o.iterations = 7;
+  o.seed = 9;
+  jsa::apply_paper_preset(o);
+  const jsa::LossWeights paper;
+  CHECK(o.weights.surface == paper.surface);
+  CHECK(o.weights.chart == paper.chart);
+  CHECK(o.weights.cycle == 1.0);
+  CHECK(o.weights.isometry == paper.isometry);
+  CHECK(o.weights.repulsion == paper.repulsion);
+  CHECK(o.atlas.gaussians == 10000);
+  CHECK(o.points == 10000);
+  CHECK(o.atlas.alpha == 0.01);
+  CHECK(o.atlas.softplus_beta == 0);
+  CHECK_FALSE(o.dense_surface);
+  CHECK(o.iterations == 7);
+  CHECK(o.seed == 9);
+  CHECK(jsa::fit_options_to_json(jsa::paper_fit_options()).find("\"cycle\": 1.0") != std::string::npos);
+}
+
 TEST_CASE("fit config: settings added later read as what older runs did", "[fit_config]") {
   jsa::FitOptions o;
   o.orient_every = 25;
