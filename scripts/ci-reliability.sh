@@ -3,8 +3,9 @@
 # UndefinedBehaviorSanitizer, (b) each libFuzzer target for a bounded time on its
 # seed corpus (test/fuzz/corpus/<target>), deterministically (fixed seed and
 # number of inputs). Prints how long each step took.
-# Builds in build-asan/ and build-fuzz/; installs clang-14 and libclang-rt-14-dev
-# when missing. FUZZ_SECONDS sets the time per target (default 30).
+# Builds in build-asan/ and build-fuzz/; installs clang-14, its sanitizer runtime
+# (libclang-rt-14-dev) and its OpenMP runtime (libomp-14-dev, not a dependency of
+# clang-14) when missing. FUZZ_SECONDS sets the time per target (default 30).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 fuzz_seconds="${FUZZ_SECONDS:-120}"
@@ -24,7 +25,7 @@ step() {
 
 install_clang() {
   local missing=()
-  for p in clang-14 libclang-rt-14-dev; do
+  for p in clang-14 libclang-rt-14-dev libomp-14-dev; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
   [ ${#missing[@]} -eq 0 ] && return 0
