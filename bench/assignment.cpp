@@ -10,7 +10,7 @@
 // matrix (parallel) and of the LAPJV solve (serial), on the same sets each run
 // (every run must return the same matching).
 #include "bench/timing.h"
-#include "losses/assignment.h"
+#include "losses/metrics/assignment.h"
 
 #include <algorithm>
 #include <chrono>
@@ -24,8 +24,8 @@
 #include "engine/check.h"
 #include "engine/parallel.h"
 #include "engine/rng.h"
-#include "losses/assignment_auction.h"
-#include "losses/emd.h"
+#include "losses/metrics/assignment_auction.h"
+#include "losses/metrics/emd.h"
 
 namespace {
 

@@ -9,9 +9,9 @@
 #include <string>
 
 #include "engine/parallel.h"
-#include "model/domain_mesh.h"
-#include "model/shape_input.h"
-#include "model/trainer.h"
+#include "model/tool/domain_mesh.h"
+#include "model/tool/shape_input.h"
+#include "model/tool/trainer.h"
 
 using namespace jsa;
 

@@ -30,9 +30,9 @@
 #include "engine/parallel.h"
 #include "engine/tangents.h"
 #include "losses/chamfer.h"
-#include "losses/nearest.h"
+#include "io/geometry/nearest.h"
 #include "losses/repulsion.h"
-#include "model/trainer.h"
+#include "model/tool/trainer.h"
 
 using namespace jsa;
 using Clock = std::chrono::steady_clock;

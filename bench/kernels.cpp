@@ -31,11 +31,11 @@
 #include "bench/timing.h"
 #include "engine/parallel.h"
 #include "engine/rng.h"
-#include "losses/assignment.h"
-#include "losses/assignment_auction.h"
+#include "losses/metrics/assignment.h"
+#include "losses/metrics/assignment_auction.h"
 #include "losses/chamfer.h"
-#include "losses/emd.h"
-#include "losses/nearest.h"
+#include "losses/metrics/emd.h"
+#include "io/geometry/nearest.h"
 #include "losses/repulsion.h"
 
 namespace {

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "io/image.h"
-#include "io/plot.h"
+#include "io/pictures/image.h"
+#include "io/pictures/plot.h"
 
 int main(int argc, char** argv) {
   if (argc != 3) {

@@ -1,5 +1,5 @@
 // The paper's Table 1 for one category of shapes, in one command: the AtlasNet
-// baselines (rows 1-4, model/atlasnet.h) and the ablation of the method (rows
+// baselines (rows 1-4, model/baselines/atlasnet.h) and the ablation of the method (rows
 // 6-11, Components::table_row), each fitted to the whole category as one
 // collection with every seed, then scored as the paper does (Sec. 4): Chamfer
 // and exact-EMD associations on M' = 2000 samples (spatial and normal
@@ -32,10 +32,10 @@
 #include "engine/parallel.h"
 #include "io/atomic_write.h"
 #include "io/keypoints.h"
-#include "model/atlasnet.h"
-#include "model/correspondence.h"
-#include "model/evaluate.h"
-#include "model/shape_input.h"
+#include "model/baselines/atlasnet.h"
+#include "model/tool/correspondence.h"
+#include "model/tool/evaluate.h"
+#include "model/tool/shape_input.h"
 
 using namespace jsa;
 namespace fs = std::filesystem;

@@ -13,11 +13,11 @@
 #include "engine/parallel.h"
 #include "io/atomic_write.h"
 #include "io/keypoints.h"
-#include "losses/nearest.h"
-#include "model/checkpoint.h"
-#include "model/correspondence.h"
-#include "model/fit_config.h"
-#include "model/shape_input.h"
+#include "io/geometry/nearest.h"
+#include "model/tool/checkpoint.h"
+#include "model/tool/correspondence.h"
+#include "model/tool/fit_config.h"
+#include "model/tool/shape_input.h"
 
 namespace jsa::cli {
 namespace {

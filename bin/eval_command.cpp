@@ -8,9 +8,9 @@
 #include "bin/commands.h"
 #include "engine/parallel.h"
 #include "io/atomic_write.h"
-#include "model/checkpoint.h"
-#include "model/evaluate.h"
-#include "model/shape_input.h"
+#include "model/tool/checkpoint.h"
+#include "model/tool/evaluate.h"
+#include "model/tool/shape_input.h"
 
 namespace jsa::cli {
 namespace {

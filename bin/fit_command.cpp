@@ -16,9 +16,9 @@
 #include "bin/run_files.h"
 #include "engine/parallel.h"
 #include "io/atomic_write.h"
-#include "io/image.h"
-#include "model/checkpoint.h"
-#include "model/fit_config.h"
+#include "io/pictures/image.h"
+#include "model/tool/checkpoint.h"
+#include "model/tool/fit_config.h"
 
 namespace jsa::cli {
 namespace {
@@ -268,11 +268,11 @@ void add_fit(CLI::App& app) {
   c->add_option("--repulsion-tolerance", o.repulsion_tolerance, "Bound on the error of L_rep from its cut-off radius")->capture_default_str()->check(CLI::Range(1e-15, 1e-2))->check(kFinite);
   c->add_option("--softplus", o.atlas.softplus_beta, "Activation of phi and psi: BETA > 0 softplus log(1 + e^(BETA z)) / BETA (smooth normals), 0 ReLU (the paper)")->capture_default_str()->check(CLI::Range(0.0, 1e6))->check(kFinite);
   c->add_option("--code-layer", o.atlas.code_layer, "Collections: where the codes enter phi and psi: 0 the input (concatenation), 1 after the first layer")->capture_default_str()->check(CLI::Range(0, 1));
-  c->add_option("--reseed", o.reseed_every, "Every N steps before the first decay, move the Gaussians of back-facing flaps to the surface's holes (0: never, as the paper; see model/reseed.h)")->capture_default_str()->check(CLI::Range(0, 1000000));
+  c->add_option("--reseed", o.reseed_every, "Every N steps before the first decay, move the Gaussians of back-facing flaps to the surface's holes (0: never, as the paper; see model/heuristics/reseed.h)")->capture_default_str()->check(CLI::Range(0, 1000000));
   c->add_flag("--dense-surface,!--no-dense-surface", o.dense_surface, "L_6D matches phi6(x_P) in the whole pool of surface samples, not only the step's M (sharper pull; see losses/chamfer.h)")->capture_default_str();
-  c->add_option("--wrap", o.wrap_steps, "Steps fitting phi and psi to a closed ellipsoid around the shape before training (0: random start, as the paper; see model/wrap.h)")->capture_default_str()->check(CLI::Range(0, 1000000));
+  c->add_option("--wrap", o.wrap_steps, "Steps fitting phi and psi to a closed ellipsoid around the shape before training (0: random start, as the paper; see model/heuristics/wrap.h)")->capture_default_str()->check(CLI::Range(0, 1000000));
   c->add_option("--batch-shapes", o.batch_shapes, "Collections: shapes per iteration, a seeded random subset (0: all); the loss is scaled by N/B")->capture_default_str()->check(CLI::NonNegativeNumber);
-  c->add_option("--orient-every", o.orient_every, "Choose phi's global orientation every N iterations until the first decay (0: never; see model/orientation.h)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  c->add_option("--orient-every", o.orient_every, "Choose phi's global orientation every N iterations until the first decay (0: never; see model/heuristics/orientation.h)")->capture_default_str()->check(CLI::NonNegativeNumber);
   c->add_option("--checkpoint-every", a->checkpoint_every, "Write model.ckpt every N iterations (0: only at the end)")->capture_default_str()->check(CLI::NonNegativeNumber);
   c->add_option("--mesh-resolution", a->mesh_resolution, "Grid cells across the domain for domain_mesh.obj")->capture_default_str()->check(CLI::Range(8, 4096));
   c->add_option("--mesh-threshold", a->mesh_threshold, "Domain = {P >= t * median of P at the means}")->capture_default_str()->check(CLI::Range(0.0, 100.0))->check(kFinite);

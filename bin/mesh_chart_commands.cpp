@@ -6,7 +6,7 @@
 #include "bin/commands.h"
 #include "bin/run_files.h"
 #include "engine/parallel.h"
-#include "model/checkpoint.h"
+#include "model/tool/checkpoint.h"
 
 namespace jsa::cli {
 namespace {

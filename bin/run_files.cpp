@@ -7,11 +7,11 @@
 
 #include "io/atomic_write.h"
 #include "io/mesh_io.h"
-#include "losses/uv_quality.h"
-#include "model/chart_mesh.h"
-#include "model/domain_mesh.h"
-#include "model/pictures.h"
-#include "io/raster.h"
+#include "losses/metrics/uv_quality.h"
+#include "model/tool/chart_mesh.h"
+#include "model/tool/domain_mesh.h"
+#include "io/pictures/run_pictures.h"
+#include "io/pictures/raster.h"
 
 namespace jsa::cli {
 namespace {

@@ -5,8 +5,8 @@
 #include <string>
 
 #include "model/atlas.h"
-#include "model/loss_log.h"
-#include "model/shape_input.h"
+#include "model/tool/loss_log.h"
+#include "model/tool/shape_input.h"
 
 namespace jsa::cli {
 

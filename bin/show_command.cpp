@@ -5,8 +5,8 @@
 #include "bin/commands.h"
 #include "bin/run_files.h"
 #include "engine/parallel.h"
-#include "model/checkpoint.h"
-#include "model/fit_config.h"
+#include "model/tool/checkpoint.h"
+#include "model/tool/fit_config.h"
 
 namespace jsa::cli {
 namespace {

@@ -1,19 +1,22 @@
-# cmake --install: the four libraries and jsatlas_flags as jsatlas::engine,
-# jsatlas::io, jsatlas::losses, jsatlas::model and jsatlas::flags, the public
-# headers under <prefix>/include/jsatlas (still included as "engine/tape.h"), the
+# cmake --install: the room libraries (cmake/rooms.cmake) as jsatlas::<room>
+# (jsatlas::engine, jsatlas::geometry, ..., jsatlas::pictures) and jsatlas_flags
+# as jsatlas::flags, the public headers under <prefix>/include/jsatlas with their
+# sub-folders (still included as "engine/tape.h", "io/geometry/mesh.h"), the
 # jsatlas binary, and a package config so that another project can write
 #   find_package(jsatlas REQUIRED)
-#   target_link_libraries(app PRIVATE jsatlas::model)
+#   target_link_libraries(app PRIVATE jsatlas::model jsatlas::io)
 # Component "development" is everything but the binary (component "cli").
 include(CMakePackageConfigHelpers)
 set(JSATLAS_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/jsatlas)
 
 set_target_properties(jsatlas_flags PROPERTIES EXPORT_NAME flags)
-foreach(room engine io losses model)
+set(room_targets)
+foreach(room ${jsatlas_rooms})
   set_target_properties(jsatlas_${room} PROPERTIES EXPORT_NAME ${room})
+  list(APPEND room_targets jsatlas_${room})
 endforeach()
 
-install(TARGETS jsatlas_flags jsatlas_engine jsatlas_io jsatlas_losses jsatlas_model
+install(TARGETS jsatlas_flags ${room_targets}
         EXPORT jsatlasTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT development
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT development)

@@ -1,9 +1,9 @@
 // Example: chart a mesh and write it with UVs. A short fit of builtin:sphere,
-// then psi maps every vertex of the mesh to the 2D domain (model/chart_mesh.h),
+// then psi maps every vertex of the mesh to the 2D domain (model/tool/chart_mesh.h),
 // triangles torn across the cut get their own UV corners, and the mesh is
 // written as an OBJ with texture coordinates (io/mesh_io.h).
 // Usage: example_chart_mesh [out.obj]. Exits non-zero if the chart is unusable.
-#include "model/chart_mesh.h"
+#include "model/tool/chart_mesh.h"
 
 #include <cstdio>
 #include <exception>
@@ -11,10 +11,10 @@
 
 #include "engine/parallel.h"
 #include "io/mesh_io.h"
-#include "losses/uv_quality.h"
-#include "model/domain_mesh.h"
-#include "model/shape_input.h"
-#include "model/trainer.h"
+#include "losses/metrics/uv_quality.h"
+#include "model/tool/domain_mesh.h"
+#include "model/tool/shape_input.h"
+#include "model/tool/trainer.h"
 
 using namespace jsa;
 

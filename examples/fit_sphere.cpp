@@ -1,4 +1,4 @@
-// Example: fit an atlas of the unit sphere with the Trainer (model/trainer.h).
+// Example: fit an atlas of the unit sphere with the Trainer (model/tool/trainer.h).
 // FitOptions holds every setting, each with a documented default; here they are
 // made small (K = 256 Gaussians, 3 x 32 MLPs, M = 256 points) so the fit takes a few
 // seconds. The library never prints: the loop below reports progress itself.
@@ -8,7 +8,7 @@
 #include <exception>
 
 #include "engine/parallel.h"
-#include "model/trainer.h"
+#include "model/tool/trainer.h"
 
 using namespace jsa;
 

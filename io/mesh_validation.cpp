@@ -8,7 +8,7 @@
 #include <utility>
 
 #include "io/input_file.h"
-#include "io/vertex_normals.h"
+#include "io/geometry/vertex_normals.h"
 
 namespace jsa {
 namespace {

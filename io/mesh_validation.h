@@ -5,7 +5,7 @@
 #pragma once
 #include <string>
 
-#include "io/mesh.h"
+#include "io/geometry/mesh.h"
 
 namespace jsa {
 

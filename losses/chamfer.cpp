@@ -3,7 +3,7 @@
 #include "losses/chamfer.h"
 
 #include "engine/parallel.h"
-#include "losses/nearest.h"
+#include "io/geometry/nearest.h"
 
 namespace jsa {
 namespace {

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "engine/tape.h"
-#include "losses/nearest.h"
+#include "io/geometry/nearest.h"
 
 namespace jsa {
 

@@ -1,5 +1,7 @@
 #include "model/atlas.h"
 
+#include <algorithm>
+
 #include "engine/ops.h"
 
 namespace jsa {
@@ -50,5 +52,29 @@ void Atlas<T>::initialize(Rng& rng) {
 
 template class Atlas<float>;
 template class Atlas<double>;
+
+void evaluate_surface(Atlas<float>& atlas, const Block<double>& uv, Block<double>& points,
+                      Block<double>& normals, int shape) {
+  points.resize(uv.rows(), 3);
+  normals.resize(uv.rows(), 3);
+  Tape<float> t;
+  const Index batch = 8192;
+  for (Index b = 0; b < uv.rows(); b += batch) {
+    const Index n = std::min(batch, uv.rows() - b);
+    t.clear();
+    Var x = t.constant(uv.middleRows(b, n).cast<float>());
+    SurfacePoints s = atlas.phi.evaluate(t, atlas.params, x, true, atlas.phi_code(t, shape));
+    points.middleRows(b, n) = t.value(s.points).cast<double>();
+    normals.middleRows(b, n) = t.value(s.normals).cast<double>().rowwise().normalized();
+  }
+}
+
+void sample_reconstruction(Atlas<float>& atlas, Index count, Rng& rng, Block<double>& uv,
+                           Block<double>& points, Block<double>& normals, int shape) {
+  Tape<float> t;
+  Var x = atlas.domain.sample(t, atlas.params, count, rng);
+  uv = t.value(x).cast<double>();
+  evaluate_surface(atlas, uv, points, normals, shape);
+}
 
 }  // namespace jsa

@@ -48,4 +48,13 @@ class Atlas {
   int phi_codes_ = -1, psi_codes_ = -1;  // N x D parameter blocks
 };
 
+// The reconstruction (Sec. 3): phi of shape `shape` at the rows of uv (V x 2),
+// in batches: points (V x 3, unit frame) and unit normals (V x 3).
+void evaluate_surface(Atlas<float>& atlas, const Block<double>& uv, Block<double>& points,
+                      Block<double>& normals, int shape = 0);
+
+// `count` points of the reconstruction: uv ~ P, points = phi(uv), unit normals.
+void sample_reconstruction(Atlas<float>& atlas, Index count, Rng& rng, Block<double>& uv,
+                           Block<double>& points, Block<double>& normals, int shape = 0);
+
 }  // namespace jsa

@@ -24,7 +24,7 @@ class Parametrization {
   Parametrization() = default;
   // in = 2, out = 3 (code_size: the latent code width in a collection). name:
   // the prefix of its parameters; a model with several (AtlasNet's patches,
-  // model/atlasnet.h) gives each its own.
+  // model/baselines/atlasnet.h) gives each its own.
   Parametrization(Parameters<T>& params, const MlpShape& shape, T alpha,
                   const std::string& name = "phi")
       : mlp_(params, name, shape), alpha_(alpha) {}

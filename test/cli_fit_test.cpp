@@ -9,8 +9,8 @@
 
 #include <tiny_obj_loader.h>
 
-#include "io/builtin_shapes.h"
-#include "io/image.h"
+#include "io/geometry/builtin_shapes.h"
+#include "io/pictures/image.h"
 #include "test/cli_test_support.h"
 
 using namespace cli_test;

@@ -8,7 +8,7 @@
 #include <functional>
 
 #include "engine/check.h"
-#include "io/builtin_shapes.h"
+#include "io/geometry/builtin_shapes.h"
 #include "io/mesh_io.h"
 
 #include "test/scratch.h"

@@ -1,11 +1,11 @@
-// Built against an installed jsatlas (find_package, jsatlas::model): makes a
-// small atlas, evaluates phi and its normals at a few domain points, and reads
-// back a mesh it wrote, so the link line needs the private readers of jsatlas::io
-// too. Prints "consumer ok" and exits 0 when every number is finite.
+// Built against an installed jsatlas (find_package, jsatlas::model and
+// jsatlas::io): makes a small atlas, evaluates phi and its normals at a few
+// domain points, and reads back a mesh it wrote, so the link line needs the
+// private readers of jsatlas::io too. Prints "consumer ok" and exits 0 when every number is finite.
 #include <cstdio>
 #include <exception>
 
-#include "io/builtin_shapes.h"
+#include "io/geometry/builtin_shapes.h"
 #include "io/mesh_io.h"
 #include "losses/chamfer.h"
 #include "model/atlas.h"

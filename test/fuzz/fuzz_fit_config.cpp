@@ -1,6 +1,6 @@
 // Fuzz target: fit_options_from_json on a config.json text (what --resume reads
 // back from a run directory).
-#include "model/fit_config.h"
+#include "model/tool/fit_config.h"
 #include "test/fuzz/fuzz_input_file.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -5,13 +5,13 @@
 // of a checkpoint that parses is then read as FitOptions, as --resume does.
 #include <cstring>
 
-#include "model/checkpoint.h"
-#include "model/fit_config.h"
+#include "model/tool/checkpoint.h"
+#include "model/tool/fit_config.h"
 #include "test/fuzz/fuzz_input_file.h"
 
 namespace {
 
-// The checkpoint's checksum (model/checkpoint.cpp): 64-bit FNV-1a.
+// The checkpoint's checksum (model/tool/checkpoint.cpp): 64-bit FNV-1a.
 uint64_t fnv1a(const uint8_t* p, size_t n) {
   uint64_t h = 1469598103934665603ull;
   for (size_t i = 0; i < n; ++i) {

@@ -1,0 +1,238 @@
+// nanoflann behind our interface. Three small pieces plug into its kd-tree:
+//   RowsSource  : the point set, a row-major N x C block seen as N points;
+//   SquaredL2   : the metric, |a - b|^2 summed in column order, as in the
+//                 brute-force oracle;
+//   ClosestOne  : a one-slot result set that breaks ties by the lowest index.
+// The tree is built once per call (O(N log N), serial) and queried in parallel.
+#include "io/geometry/nearest.h"
+
+#include <cstdint>
+#include <limits>
+#include <nanoflann.hpp>
+
+#include "engine/check.h"
+
+namespace jsa {
+namespace {
+
+template <class T>
+struct RowsSource {
+  const T* data;
+  size_t rows, cols;
+  size_t kdtree_get_point_count() const { return rows; }
+  T kdtree_get_pt(uint32_t i, size_t d) const { return data[size_t(i) * cols + d]; }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const {
+    return false;  // let the tree compute its own bounding box
+  }
+};
+
+// |a - b|^2 over C columns. Dim > 0 fixes C at compile time so the loop unrolls.
+template <class T, int Dim>
+T squared_l2(const T* a, const T* b, size_t cols) {
+  const size_t c = Dim > 0 ? size_t(Dim) : cols;
+  T s = T(0);
+  for (size_t d = 0; d < c; ++d) {
+    const T diff = a[d] - b[d];
+    s += diff * diff;
+  }
+  return s;
+}
+
+template <class T, int Dim>
+struct SquaredL2 {
+  using ElementType = T;
+  using DistanceType = T;
+  const RowsSource<T>& source;
+  explicit SquaredL2(const RowsSource<T>& s) : source(s) {}
+  T evalMetric(const T* a, uint32_t b, size_t cols) const {
+    return squared_l2<T, Dim>(a, source.data + size_t(b) * source.cols, cols);
+  }
+  // One coordinate's share of the squared distance (used for pruning).
+  template <class U, class V>
+  T accum_dist(U a, V b, size_t) const {
+    return T((a - b) * (a - b));
+  }
+};
+
+// Keeps the single closest point; equal distances go to the lower index.
+// The tree prunes a cell when its (rounded) lower bound exceeds worstDist(), so
+// worstDist() reports the best distance inflated by a few ulps: a cell holding a
+// point tied with, or within rounding of, the best is still visited, and
+// addPoint() makes the exact comparison.
+template <class T>
+class ClosestOne {
+ public:
+  bool addPoint(T dist, uint32_t index) {
+    if (dist < best_ || (dist == best_ && index < index_)) {
+      best_ = dist;
+      index_ = index;
+      slack_ = best_ * (T(1) + 8 * std::numeric_limits<T>::epsilon()) +
+               std::numeric_limits<T>::denorm_min();
+    }
+    return true;  // keep searching
+  }
+  T worstDist() const { return slack_; }
+  bool full() const { return index_ != kNone; }
+  T distance() const { return best_; }
+  uint32_t index() const { return index_; }
+
+ private:
+  static constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
+  T best_ = std::numeric_limits<T>::max();
+  T slack_ = std::numeric_limits<T>::infinity();
+  uint32_t index_ = kNone;
+};
+
+template <class T, int Dim>
+using KdTree = nanoflann::KDTreeSingleIndexAdaptor<SquaredL2<T, Dim>, RowsSource<T>, Dim, uint32_t>;
+
+// Leaves of ~16 points: a leaf scan is a short, branch-light loop.
+template <class T, int Dim>
+std::unique_ptr<KdTree<T, Dim>> build_tree(const RowsSource<T>& source) {
+  return std::make_unique<KdTree<T, Dim>>(source.cols, source, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+}
+
+template <class T, int Dim>
+void query_tree(const KdTree<T, Dim>& tree, const Block<T>& queries, std::vector<int>& index,
+                std::vector<T>* squared_distance) {
+  const nanoflann::SearchParams params;  // eps = 0: exact search
+  const Index m = queries.rows();
+  const T* q = queries.data();
+  const size_t c = size_t(queries.cols());
+  T* dist = squared_distance ? squared_distance->data() : nullptr;
+  // Small batches stay serial: a parallel region costs more than it saves, and
+  // far more when another process holds the second core.
+#pragma omp parallel for schedule(dynamic, 256) if (m > 1024)
+  for (Index i = 0; i < m; ++i) {
+    ClosestOne<T> best;
+    tree.findNeighbors(best, q + size_t(i) * c, params);
+    index[i] = int(best.index());
+    if (dist) dist[i] = best.distance();
+  }
+}
+
+template <class T, int Dim>
+void nearest_kdtree(const Block<T>& queries, const Block<T>& points, std::vector<int>& index,
+                    std::vector<T>* squared_distance) {
+  const RowsSource<T> source{points.data(), size_t(points.rows()), size_t(points.cols())};
+  query_tree<T, Dim>(*build_tree<T, Dim>(source), queries, index, squared_distance);
+}
+
+template <class T>
+void check_shapes(const Block<T>& queries, const Block<T>& points) {
+  JSA_CHECK(points.rows() >= 1, "nearest: no points to search");
+  JSA_CHECK(queries.cols() == points.cols(),
+            "nearest: queries have " << queries.cols() << " columns, points " << points.cols());
+  JSA_CHECK(points.rows() < Index(std::numeric_limits<int>::max()), "nearest: too many points");
+  JSA_CHECK(queries.allFinite() && points.allFinite(), "nearest: a coordinate is not finite");
+}
+
+}  // namespace
+
+template <class T>
+void nearest(const Block<T>& queries, const Block<T>& points, std::vector<int>& index,
+             std::vector<T>* squared_distance) {
+  check_shapes(queries, points);
+  index.resize(queries.rows());
+  if (squared_distance) squared_distance->resize(queries.rows());
+  switch (points.cols()) {
+    case 2:
+      return nearest_kdtree<T, 2>(queries, points, index, squared_distance);
+    case 3:
+      return nearest_kdtree<T, 3>(queries, points, index, squared_distance);
+    case 6:
+      return nearest_kdtree<T, 6>(queries, points, index, squared_distance);
+    default:
+      return nearest_kdtree<T, -1>(queries, points, index, squared_distance);
+  }
+}
+
+// NearestIndex: the points, and a tree over them whose column count is fixed
+// at compile time where nearest() fixes it.
+template <class T>
+struct NearestIndex<T>::Impl {
+  Block<T> points;
+  RowsSource<T> source;
+  explicit Impl(Block<T> p) : points(std::move(p)), source{points.data(), size_t(points.rows()), size_t(points.cols())} {}
+  virtual ~Impl() = default;
+  virtual void query(const Block<T>& q, std::vector<int>& index, std::vector<T>* d) const = 0;
+};
+
+namespace {
+template <class T, int Dim>
+struct TreeImpl final : NearestIndex<T>::Impl {
+  std::unique_ptr<KdTree<T, Dim>> tree;
+  explicit TreeImpl(Block<T> p) : NearestIndex<T>::Impl(std::move(p)), tree(build_tree<T, Dim>(this->source)) {}
+  void query(const Block<T>& q, std::vector<int>& index, std::vector<T>* d) const override {
+    query_tree<T, Dim>(*tree, q, index, d);
+  }
+};
+}  // namespace
+
+template <class T>
+NearestIndex<T>::NearestIndex(Block<T> points) {
+  check_shapes(points, points);
+  switch (points.cols()) {
+    case 2: impl_ = std::make_unique<TreeImpl<T, 2>>(std::move(points)); break;
+    case 3: impl_ = std::make_unique<TreeImpl<T, 3>>(std::move(points)); break;
+    case 6: impl_ = std::make_unique<TreeImpl<T, 6>>(std::move(points)); break;
+    default: impl_ = std::make_unique<TreeImpl<T, -1>>(std::move(points)); break;
+  }
+}
+
+template <class T>
+NearestIndex<T>::~NearestIndex() = default;
+template <class T>
+NearestIndex<T>::NearestIndex(NearestIndex&&) noexcept = default;
+template <class T>
+NearestIndex<T>& NearestIndex<T>::operator=(NearestIndex&&) noexcept = default;
+
+template <class T>
+void NearestIndex<T>::query(const Block<T>& queries, std::vector<int>& index,
+                            std::vector<T>* squared_distance) const {
+  check_shapes(queries, impl_->points);
+  index.resize(queries.rows());
+  if (squared_distance) squared_distance->resize(queries.rows());
+  impl_->query(queries, index, squared_distance);
+}
+
+template <class T>
+const Block<T>& NearestIndex<T>::points() const {
+  return impl_->points;
+}
+
+template <class T>
+void nearest_brute_force(const Block<T>& queries, const Block<T>& points, std::vector<int>& index,
+                         std::vector<T>* squared_distance) {
+  check_shapes(queries, points);
+  const Index m = queries.rows(), n = points.rows();
+  const size_t c = size_t(points.cols());
+  index.resize(m);
+  if (squared_distance) squared_distance->resize(m);
+#pragma omp parallel for schedule(static) if (m > 64)
+  for (Index i = 0; i < m; ++i) {
+    const T* q = queries.data() + size_t(i) * c;
+    T best = std::numeric_limits<T>::max();
+    int best_j = -1;
+    for (Index j = 0; j < n; ++j) {
+      const T d = squared_l2<T, -1>(q, points.data() + size_t(j) * c, c);
+      if (best_j < 0 || d < best) {  // strict: the lowest index wins ties
+        best = d;
+        best_j = int(j);
+      }
+    }
+    index[i] = best_j;
+    if (squared_distance) (*squared_distance)[i] = best;
+  }
+}
+
+#define JSA_INSTANTIATE(T)                                                                        \
+  template void nearest<T>(const Block<T>&, const Block<T>&, std::vector<int>&, std::vector<T>*); \
+  template void nearest_brute_force<T>(const Block<T>&, const Block<T>&, std::vector<int>&,       \
+                                       std::vector<T>*);       \
+  template class NearestIndex<T>;
+JSA_INSTANTIATE(float)
+JSA_INSTANTIATE(double)
+
+}  // namespace jsa

@@ -1,0 +1,100 @@
+#include "model/tool/correspondence.h"
+
+#include "io/geometry/vertex_normals.h"
+#include "io/geometry/nearest.h"
+#include "model/tool/chart_mesh.h"
+#include "model/tool/domain_mesh.h"
+#include "model/tool/evaluate.h"
+
+namespace jsa {
+
+Block<double> vertex_normals_of(const Mesh& mesh) {
+  if (mesh.has_normals()) return mesh.normals.rowwise().normalized();
+  return area_weighted_vertex_normals(mesh.vertices, mesh.faces);
+}
+
+Block<double> correspond(Atlas<float>& atlas, int from, int to, const Block<double>& p_unit,
+                         const Block<double>& normals, const CorrespondenceOptions& o) {
+  Block<double> uv;
+  if (o.use_chart) {
+    // x = psi_I([p, alpha n])
+    Block<double> x6(p_unit.rows(), 6);
+    x6.leftCols(3) = p_unit;
+    x6.rightCols(3) = atlas.options().alpha * normals.rowwise().normalized();
+    uv = chart_points(atlas, x6, from);
+  } else {
+    // The nearest-sample rule: argmin over samples x ~ P of |phi_I(x) - p|.
+    Rng rng(o.seed, 20);
+    Block<double> samples, points, sample_normals;
+    sample_reconstruction(atlas, o.nearest_samples, rng, samples, points, sample_normals, from);
+    std::vector<int> nn;
+    nearest(p_unit, points, nn);
+    uv.resize(p_unit.rows(), 2);
+    for (Index i = 0; i < p_unit.rows(); ++i) uv.row(i) = samples.row(nn[size_t(i)]);
+  }
+  Block<double> q, qn;
+  evaluate_surface(atlas, uv, q, qn, to);  // q = phi_J(x)
+  return q;
+}
+
+KeypointError keypoint_error(Atlas<float>& atlas, const std::vector<Mesh>& meshes,
+                             const std::vector<Normalization>& frames,
+                             const std::vector<std::vector<int>>& keypoints, const CorrespondenceOptions& o,
+                             const std::vector<double>& thresholds) {
+  const CorrespondenceMap map = [&](int from, int to, const Block<double>& p,
+                                    const Block<double>& n) {
+    return correspond(atlas, from, to, p, n, o);
+  };
+  return keypoint_error(map, meshes, frames, keypoints, thresholds);
+}
+
+KeypointError keypoint_error(const CorrespondenceMap& map, const std::vector<Mesh>& meshes,
+                             const std::vector<Normalization>& frames,
+                             const std::vector<std::vector<int>>& keypoints,
+                             const std::vector<double>& thresholds) {
+  const size_t n = meshes.size();
+  JSA_CHECK(frames.size() == n && keypoints.size() == n, "one mesh, frame and keypoint list per shape");
+  const size_t k = keypoints[0].size();
+  for (size_t i = 0; i < n; ++i)
+    if (keypoints[i].size() != k)
+      throw InputError("keypoint files differ in length: shape 0 has " + std::to_string(k) + ", shape " +
+                       std::to_string(i) + " has " + std::to_string(keypoints[i].size()));
+  KeypointError e;
+  e.thresholds = thresholds;
+  e.within.assign(thresholds.size(), 0.0);
+  e.pair_mean.assign(n, std::vector<double>(n, 0.0));
+  double total = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const Block<double> unit = frames[i].to_unit(meshes[i].vertices);
+    const Block<double> normals = vertex_normals_of(meshes[i]);
+    Block<double> p(Index(k), 3), pn(Index(k), 3);
+    for (size_t m = 0; m < k; ++m) {
+      p.row(Index(m)) = unit.row(keypoints[i][m]);
+      pn.row(Index(m)) = normals.row(keypoints[i][m]);
+    }
+    for (size_t j = 0; j < n; ++j) {
+      if (i == j) continue;
+      const Block<double> q = map(int(i), int(j), p, pn);
+      const Block<double> target = frames[j].to_unit(meshes[j].vertices);
+      double pair = 0;
+      for (size_t m = 0; m < k; ++m) {
+        const double d = (q.row(Index(m)) - target.row(keypoints[j][m])).norm();
+        pair += d;
+        for (size_t t = 0; t < thresholds.size(); ++t)
+          if (d <= thresholds[t]) e.within[t] += 1;
+      }
+      e.pair_mean[i][j] = pair / double(k);
+      total += pair;
+      ++e.pairs;
+    }
+  }
+  e.keypoints = Index(k);
+  const double count = double(e.pairs) * double(k);
+  if (count > 0) {
+    e.mean = total / count;
+    for (double& w : e.within) w /= count;
+  }
+  return e;
+}
+
+}  // namespace jsa

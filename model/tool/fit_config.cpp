@@ -1,0 +1,162 @@
+#include "model/tool/fit_config.h"
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <type_traits>
+
+#include <nlohmann/json.hpp>
+
+namespace jsa {
+
+using nlohmann::json;
+
+namespace {
+
+// Whether the JSON number `value` fits the integer type T. nlohmann's get_to
+// converts with static_cast: undefined behaviour for 1e300 into an int (UBSan in
+// fuzz_fit_config), a silent wrap for 10^10. Non-numbers and non-integer T pass
+// here; get_to reports a wrong type itself.
+template <class T>
+bool fits(const json& value) {
+  if constexpr (!std::is_integral_v<T> || std::is_same_v<T, bool>) {
+    return true;
+  } else {
+    using Limits = std::numeric_limits<T>;
+    if (value.is_number_float()) {
+      const double d = value.get<double>();
+      const double bound = std::ldexp(1.0, Limits::digits);  // 2^31 for int, 2^64 for uint64_t
+      return d == std::floor(d) && d < bound && d >= (Limits::is_signed ? -bound : 0.0);
+    }
+    if (value.is_number_unsigned())
+      return value.get<std::uint64_t>() <= std::uint64_t(Limits::max());
+    if (value.is_number_integer()) {
+      const std::int64_t v = value.get<std::int64_t>();
+      if (v < 0) return Limits::is_signed && v >= std::int64_t(Limits::min());
+      return std::uint64_t(v) <= std::uint64_t(Limits::max());
+    }
+    return true;
+  }
+}
+
+}  // namespace
+
+std::string fit_options_to_json(const FitOptions& o, int indent) {
+  json j;
+  j["atlas"] = {{"gaussians", o.atlas.gaussians},
+                {"width", o.atlas.width},
+                {"hidden_layers", o.atlas.hidden_layers},
+                {"alpha", o.atlas.alpha},
+                {"shapes", o.atlas.shapes},
+                {"code_size", o.atlas.code_size},
+                {"code_layer", o.atlas.code_layer},
+                {"softplus_beta", o.atlas.softplus_beta}};
+  j["weights"] = {{"surface_6d", o.weights.surface},
+                  {"chart_2d", o.weights.chart},
+                  {"cycle", o.weights.cycle},
+                  {"isometry", o.weights.isometry},
+                  {"repulsion", o.weights.repulsion},
+                  {"code", o.weights.code},
+                  {"convention", "mean over points (paper's 1/M factors folded in)"}};
+  j["components"] = {{"normals", o.components.normals},
+                     {"repulsion", o.components.repulsion},
+                     {"distribution", o.components.distribution},
+                     {"chart", o.components.chart},
+                     {"isometry", o.components.isometry}};
+  j["iterations"] = o.iterations;
+  j["points"] = o.points;
+  j["lr"] = o.lr;
+  j["decay_at"] = o.decay_at;
+  j["decay"] = o.decay;
+  j["seed"] = o.seed;
+  j["repulsion_tolerance"] = o.repulsion_tolerance;
+  j["max_faults"] = o.max_faults;
+  j["orient_every"] = o.orient_every;
+  j["batch_shapes"] = o.batch_shapes;
+  j["wrap_steps"] = o.wrap_steps;
+  j["reseed_every"] = o.reseed_every;
+  j["dense_surface"] = o.dense_surface;
+  j["pool"] = o.pool;
+  j["threads"] = o.threads;
+  return j.dump(indent);
+}
+
+FitOptions fit_options_from_json(const std::string& text, const std::string& what) {
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const std::exception& e) {
+    throw InputError(what + ": not valid JSON (" + e.what() + ")");
+  }
+  FitOptions o;
+  auto field = [&](const json& obj, const char* path, const char* key, auto& out) {
+    if (!obj.is_object() || !obj.contains(key))
+      throw InputError(what + ": missing field '" + std::string(path) + key + "'");
+    if (!fits<std::decay_t<decltype(out)>>(obj.at(key)))
+      throw InputError(what + ": field '" + std::string(path) + key + "' is out of range");
+    try {
+      obj.at(key).get_to(out);
+    } catch (const std::exception&) {
+      throw InputError(what + ": field '" + std::string(path) + key + "' has the wrong type");
+    }
+  };
+  if (!j.is_object()) throw InputError(what + ": expected a JSON object");
+  const json& a = j.contains("atlas") ? j["atlas"] : json();
+  field(a, "atlas.", "gaussians", o.atlas.gaussians);
+  field(a, "atlas.", "width", o.atlas.width);
+  field(a, "atlas.", "hidden_layers", o.atlas.hidden_layers);
+  field(a, "atlas.", "alpha", o.atlas.alpha);
+  field(a, "atlas.", "shapes", o.atlas.shapes);
+  field(a, "atlas.", "code_size", o.atlas.code_size);
+  if (a.contains("code_layer")) field(a, "atlas.", "code_layer", o.atlas.code_layer);  // later addition: absent = 0
+  o.atlas.softplus_beta = 0;  // later addition: absent = ReLU, what older runs used
+  if (a.contains("softplus_beta")) field(a, "atlas.", "softplus_beta", o.atlas.softplus_beta);
+  const json& w = j.contains("weights") ? j["weights"] : json();
+  field(w, "weights.", "surface_6d", o.weights.surface);
+  field(w, "weights.", "chart_2d", o.weights.chart);
+  field(w, "weights.", "cycle", o.weights.cycle);
+  field(w, "weights.", "isometry", o.weights.isometry);
+  field(w, "weights.", "repulsion", o.weights.repulsion);
+  field(w, "weights.", "code", o.weights.code);
+  const json& c = j.contains("components") ? j["components"] : json();
+  field(c, "components.", "normals", o.components.normals);
+  field(c, "components.", "repulsion", o.components.repulsion);
+  field(c, "components.", "distribution", o.components.distribution);
+  field(c, "components.", "chart", o.components.chart);
+  field(c, "components.", "isometry", o.components.isometry);
+  field(j, "", "iterations", o.iterations);
+  field(j, "", "points", o.points);
+  field(j, "", "lr", o.lr);
+  field(j, "", "decay_at", o.decay_at);
+  field(j, "", "decay", o.decay);
+  field(j, "", "seed", o.seed);
+  field(j, "", "repulsion_tolerance", o.repulsion_tolerance);
+  field(j, "", "max_faults", o.max_faults);
+  // Added after the first checkpoints were written: a file without them comes
+  // from a run that had neither, so absent means 0 (what that run did).
+  o.orient_every = 0;
+  if (j.contains("orient_every")) field(j, "", "orient_every", o.orient_every);
+  if (j.contains("batch_shapes")) field(j, "", "batch_shapes", o.batch_shapes);
+  o.wrap_steps = 0;
+  if (j.contains("wrap_steps")) field(j, "", "wrap_steps", o.wrap_steps);
+  o.reseed_every = 0;
+  if (j.contains("reseed_every")) field(j, "", "reseed_every", o.reseed_every);
+  o.dense_surface = false;
+  if (j.contains("dense_surface")) field(j, "", "dense_surface", o.dense_surface);
+  field(j, "", "pool", o.pool);
+  field(j, "", "threads", o.threads);
+  if (o.atlas.gaussians <= 0 || o.atlas.width <= 0 || o.atlas.hidden_layers < 0 || o.points <= 0 ||
+      o.atlas.shapes <= 0 || o.atlas.code_size <= 0 || o.pool <= 0 || o.threads < 0 || o.orient_every < 0 || o.batch_shapes < 0 || o.wrap_steps < 0 || o.reseed_every < 0 || o.atlas.code_layer < 0 || o.atlas.code_layer > 1 || !(o.lr > 0) ||
+      !(o.atlas.softplus_beta >= 0) || !std::isfinite(o.atlas.softplus_beta) ||
+      !std::isfinite(o.lr))
+    throw InputError(what + ": sizes must be positive");
+  // The same bounds as the command line's, so a crafted file cannot make the
+  // atlas allocate without limit.
+  if (o.atlas.gaussians > 1000000 || o.atlas.width > 4096 || o.atlas.hidden_layers > 32 ||
+      o.atlas.code_size > 4096 || o.atlas.shapes > 100000 || o.points > 1000000 || o.pool > 10000000 ||
+      o.threads > 1024 || o.wrap_steps > 1000000)
+    throw InputError(what + ": a size is beyond the command line's limits (corrupt settings?)");
+  return o;
+}
+
+}  // namespace jsa

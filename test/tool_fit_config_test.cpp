@@ -1,0 +1,130 @@
+// FitOptions from JSON (a checkpoint's settings): every malformed text is an
+// InputError naming the source and the field, never a crash or a wrapped number.
+#include <catch2/catch.hpp>
+#include <string>
+
+#include "engine/check.h"
+#include "model/tool/fit_config.h"
+
+namespace {
+
+std::string message_of(const std::string& text) {
+  try {
+    jsa::fit_options_from_json(text, "run/model.ckpt");
+  } catch (const jsa::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// The defaults written out, with `from` (first occurrence) replaced by `to`.
+std::string edited(const std::string& from, const std::string& to) {
+  std::string text = jsa::fit_options_to_json(jsa::FitOptions(), -1);
+  const auto at = text.find(from);
+  REQUIRE(at != std::string::npos);
+  return text.replace(at, from.size(), to);
+}
+
+}  // namespace
+
+TEST_CASE("fit config: the defaults round-trip through JSON", "[fit_config]") {
+  const jsa::FitOptions o =
+      jsa::fit_options_from_json(jsa::fit_options_to_json(jsa::FitOptions()), "x");
+  CHECK(o.atlas.gaussians == jsa::FitOptions().atlas.gaussians);
+  CHECK(o.seed == jsa::FitOptions().seed);
+}
+
+TEST_CASE("fit config: the paper preset restores the paper's lambdas and keeps the run's own settings",
+          "[fit_config]") {
+  jsa::FitOptions o;
+  REQUIRE(o.weights.cycle == 0.1);  // the laptop default (docs/method.md, "lambda_cycle")
+  o.iterations = 7;
+  o.seed = 9;
+  jsa::apply_paper_preset(o);
+  const jsa::LossWeights paper;
+  CHECK(o.weights.surface == paper.surface);
+  CHECK(o.weights.chart == paper.chart);
+  CHECK(o.weights.cycle == 1.0);
+  CHECK(o.weights.isometry == paper.isometry);
+  CHECK(o.weights.repulsion == paper.repulsion);
+  CHECK(o.atlas.gaussians == 10000);
+  CHECK(o.points == 10000);
+  CHECK(o.atlas.alpha == 0.01);
+  CHECK(o.atlas.softplus_beta == 0);
+  CHECK_FALSE(o.dense_surface);
+  CHECK(o.iterations == 7);
+  CHECK(o.seed == 9);
+  CHECK(jsa::fit_options_to_json(jsa::paper_fit_options()).find("\"cycle\": 1.0") != std::string::npos);
+}
+
+TEST_CASE("fit config: settings added later read as what older runs did", "[fit_config]") {
+  jsa::FitOptions o;
+  o.orient_every = 25;
+  o.batch_shapes = 3;
+  o.wrap_steps = 40;
+  o.reseed_every = 60;
+  o.dense_surface = true;
+  o.atlas.softplus_beta = 7.5;
+  const jsa::FitOptions back = jsa::fit_options_from_json(jsa::fit_options_to_json(o), "x");
+  CHECK(back.orient_every == 25);
+  CHECK(back.batch_shapes == 3);
+  CHECK(back.wrap_steps == 40);
+  CHECK(back.reseed_every == 60);
+  CHECK(back.dense_surface);
+  CHECK(back.atlas.softplus_beta == 7.5);
+  // A checkpoint written before these existed: no orientation check, no
+  // batching, no wrap, ReLU.
+  std::string old = jsa::fit_options_to_json(o, -1);
+  for (const std::string key : {"\"orient_every\":25,", "\"batch_shapes\":3,", ",\"wrap_steps\":40", ",\"reseed_every\":60", ",\"dense_surface\":true",
+                                "\"softplus_beta\":7.5,"}) {
+    const auto at = old.find(key);
+    REQUIRE(at != std::string::npos);
+    old.erase(at, key.size());
+  }
+  const jsa::FitOptions legacy = jsa::fit_options_from_json(old, "old");
+  CHECK(legacy.orient_every == 0);
+  CHECK(legacy.batch_shapes == 0);
+  CHECK(legacy.wrap_steps == 0);
+  CHECK(legacy.reseed_every == 0);
+  CHECK(!legacy.dense_surface);
+  CHECK(legacy.atlas.softplus_beta == 0);
+  CHECK(message_of(edited("\"batch_shapes\":0", "\"batch_shapes\":-2")) == "run/model.ckpt: sizes must be positive");
+}
+
+TEST_CASE("fit config: malformed JSON is rejected naming the source and the field",
+          "[fit_config]") {
+  CHECK(message_of("{\"atlas\": 3").find("run/model.ckpt: not valid JSON") == 0);
+  CHECK(message_of("[1, 2]") == "run/model.ckpt: expected a JSON object");
+  CHECK(message_of("{}") == "run/model.ckpt: missing field 'atlas.gaussians'");
+  CHECK(message_of(edited("\"lr\":", "\"lr_\":")) == "run/model.ckpt: missing field 'lr'");
+  CHECK(message_of(edited("\"width\":", "\"width\":\"wide\",\"w\":")) ==
+        "run/model.ckpt: field 'atlas.width' has the wrong type");
+  CHECK(message_of(edited("\"points\":", "\"points\":-3,\"p\":")) ==
+        "run/model.ckpt: sizes must be positive");
+}
+
+// Found by test/fuzz/fuzz_fit_config: nlohmann's static_cast of 1e300 into an int
+// was undefined behaviour (UBSan float-cast-overflow); 10^10 wrapped silently.
+TEST_CASE("fuzz regressions: integer fields out of their type's range", "[fit_config][fuzz]") {
+  const std::string out_of_range = "run/model.ckpt: field 'atlas.gaussians' is out of range";
+  CHECK(message_of(edited("\"gaussians\":", "\"gaussians\":1e300,\"g\":")) == out_of_range);
+  CHECK(message_of(edited("\"gaussians\":", "\"gaussians\":10000000000,\"g\":")) == out_of_range);
+  CHECK(message_of(edited("\"gaussians\":", "\"gaussians\":2.5,\"g\":")) == out_of_range);
+  CHECK(message_of(edited("\"seed\":", "\"seed\":-1,\"s\":")) ==
+        "run/model.ckpt: field 'seed' is out of range");
+  CHECK(message_of(edited("\"gaussians\":", "\"gaussians\":12.0,\"g\":"))
+            .empty());  // a whole float is fine
+}
+
+TEST_CASE("fit config: sizes beyond the command line's limits are rejected before anything is allocated",
+          "[fit_config]") {
+  jsa::FitOptions o;
+  o.atlas.width = 1 << 20;
+  const std::string text = jsa::fit_options_to_json(o);
+  try {
+    jsa::fit_options_from_json(text, "settings");
+    FAIL("no InputError");
+  } catch (const jsa::InputError& e) {
+    CHECK(std::string(e.what()).find("beyond the command line's limits") != std::string::npos);
+  }
+}
