@@ -111,3 +111,55 @@ TEST_CASE("trainer: an inside-out start is mirrored, an outside-out one is not",
   CHECK(none == 0);
   CHECK(inside_out == 1);
 }
+
+TEST_CASE("mirror_domain: psi' = swap(psi) for every depth and code layer the CLI accepts", "[orientation]") {
+  // `jsatlas fit` accepts --depth 1..32 and --code-layer 0..1 (bin/fit_command.cpp;
+  // a checkpoint's settings also allow depth 0, model/fit_config.cpp); codes
+  // exist only for collections (shapes > 1). Where the code enters psi's output
+  // layer (depth 1 with code layer 1, depth 0 with code layer 0) the code weights
+  // are part of the output layer and must be mirrored with it.
+  int cases = 0;
+  for (int depth = 0; depth <= 32; ++depth)
+    for (int code_layer = 0; code_layer <= 1; ++code_layer)
+      for (int shapes : {1, 3}) {
+        if (code_layer == 1 && (depth == 0 || shapes == 1)) continue;  // no layer after the first / no codes
+        AtlasOptions ao;
+        ao.gaussians = 4;
+        ao.width = 4;
+        ao.hidden_layers = depth;
+        ao.shapes = shapes;
+        ao.code_size = 3;
+        ao.code_layer = code_layer;
+        Atlas<double> atlas(ao);
+        Rng init(uint64_t(100 + depth));
+        atlas.initialize(init);
+        // Codes of the size the MLPs' own initialisation gives the weights, not
+        // 0.01: the code's contribution must be visible in psi's output.
+        for (const char* name : {"codes.psi", "codes.phi"}) {
+          const int c = atlas.params.find(name);
+          if (c < 0) continue;
+          auto v = atlas.params.value(c);
+          for (Index i = 0; i < v.size(); ++i) v.data()[i] = init.uniform(-1, 1);
+        }
+        Block<double> x6(16, 6);
+        Rng rng(uint64_t(7 + depth));
+        for (Index i = 0; i < x6.rows(); ++i)
+          for (int c = 0; c < 6; ++c) x6(i, c) = rng.uniform(-1, 1);
+        auto chart = [&](int shape) {
+          Tape<double> t;
+          return Block<double>(t.value(atlas.psi.evaluate(t, atlas.params, t.constant(x6), atlas.psi_code(t, shape))));
+        };
+        std::vector<Block<double>> before;
+        for (int s = 0; s < shapes; ++s) before.push_back(chart(s));
+        mirror_domain(atlas);
+        for (int s = 0; s < shapes; ++s) {
+          const Block<double> after = chart(s);
+          INFO("depth " << depth << ", code layer " << code_layer << ", shapes " << shapes << ", shape " << s);
+          CHECK((after.col(0) - before[size_t(s)].col(1)).cwiseAbs().maxCoeff() < 1e-12);
+          CHECK((after.col(1) - before[size_t(s)].col(0)).cwiseAbs().maxCoeff() < 1e-12);
+          CHECK((before[size_t(s)].col(0) - before[size_t(s)].col(1)).cwiseAbs().maxCoeff() > 1e-6);  // not trivially symmetric
+        }
+        ++cases;
+      }
+  CHECK(cases == 33 * 2 + 32);  // every (depth, code layer, codes or none) above
+}

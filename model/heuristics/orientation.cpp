@@ -30,6 +30,12 @@ void mirror_domain(Atlas<T>& atlas, const std::vector<std::vector<T>*>& aligned)
   const int phi_w0 = p.find("phi.w0"), psi_w = p.find("psi.w" + std::to_string(psi_out)),
             psi_b = p.find("psi.b" + std::to_string(psi_out)), mu = atlas.domain.means();
   JSA_CHECK(phi_w0 >= 0 && psi_w >= 0 && psi_b >= 0, "mirror_domain: the atlas lacks phi or psi");
+  // With latent codes, f W_f is added to the pre-activation of layer code_layer
+  // (model/mlp.h). When that layer is psi's output layer (depth 1 with
+  // code_layer 1, or depth 0), W_f's columns are psi's outputs (u, v) too.
+  const int psi_wf = atlas.has_codes() && atlas.options().code_layer == psi_out ? p.find("psi.wf") : -1;
+  JSA_CHECK(psi_wf >= 0 || !atlas.has_codes() || atlas.options().code_layer < psi_out,
+            "mirror_domain: the atlas lacks psi's code weights");
   std::vector<std::vector<T>*> buffers{&p.values()};
   for (std::vector<T>* b : aligned)
     if (b && !b->empty()) buffers.push_back(b);  // Adam's moments are empty before the first step
@@ -39,6 +45,7 @@ void mirror_domain(Atlas<T>& atlas, const std::vector<std::vector<T>*>& aligned)
     swap_in(p, mu, *b, true);       // mu_k = (u, v): columns of K x 2
     swap_in(p, psi_w, *b, true);    // psi's outputs (u, v): columns of the last layer
     swap_in(p, psi_b, *b, true);
+    if (psi_wf >= 0) swap_in(p, psi_wf, *b, true);
   }
 }
 

@@ -9,12 +9,13 @@
 // the random initialisation. Both choices give the same L_3D, and with
 // alpha = 0.01 the normal part of L_6D (Eq. 7) is too weak a force to turn a
 // whole surface inside out one small step at a time: a run that starts
-// inside-out stays so (we measured 68% back-facing pairs on a SHREC ant).
+// inside-out stays so (measured on a SHREC ant: docs/method.md).
 // The choice is discrete, so we make it directly. Mirroring the domain,
 // (u, v) -> (v, u), reparametrizes the same surface with every normal negated:
 //   phi'(u, v) = phi(v, u)      swap the rows of phi's first weight matrix,
 //   mu'_k = (mu_k,v, mu_k,u)    the same density P, mirrored,
-//   psi'(x, n) = swap(psi(x, n)) swap the columns of psi's output layer,
+//   psi'(x, n) = swap(psi(x, n)) swap the columns of psi's output layer (and of
+//                                the code weights W_f when they feed that layer),
 // which keeps psi' the inverse of phi' and leaves every loss but the normal
 // terms unchanged. The trainer mirrors when most normals face away from the
 // target's (back_facing_fraction > 1/2).
