@@ -22,11 +22,12 @@ Block<double> random_targets(Index n, double alpha, uint64_t seed) {
 }
 
 double objective_value(Atlas<double>& atlas, const std::vector<Block<double>>& targets, const Components& c,
-                       Tape<double>& tape, bool backward) {
+                       Tape<double>& tape, bool backward, const LossWeights& weights = {}) {
   Rng rng(99);  // the same draws every evaluation: the objective is a fixed function
   tape.clear();
   ObjectiveOptions o;
   o.components = c;
+  o.weights = weights;
   Var loss = collection_objective(tape, atlas, targets, 24, rng, o, nullptr);
   if (backward) {
     atlas.params.zero_grad();
@@ -68,19 +69,28 @@ TEST_CASE("objective: gradients of L_single match central differences", "[object
     AtlasOptions ao = small_atlas_options();
     Components c = Components::table_row(row);
     ao.gaussian_noise = c.distribution;
+    // Large weights for the small terms so that they matter in the check: with
+    // the paper's lambda_iso = 1e-4 and alpha = 0.01, L_iso and the normal part
+    // of L_6D move the gradient by less than the check's tolerance, so a wrong
+    // gradient in either would pass. At weight 1 and alpha = 1 they do not
+    // (shown by breaking each, in the closing note of issue 18).
+    ao.alpha = 1.0;
+    LossWeights w;
+    w.chart = 1.0;
+    w.cycle = 1.0;
+    w.isometry = 1.0;
     Atlas<double> atlas(ao);
     Rng init(5);
     atlas.initialize(init);
-    // Large weights for the small terms so that they matter in the check.
     const std::vector<Block<double>> targets{random_targets(32, ao.alpha, 3)};
     Tape<double> tape;
-    objective_value(atlas, targets, c, tape, true);
+    objective_value(atlas, targets, c, tape, true, w);
     const std::vector<double> analytic = atlas.params.grads();
     // Central differences on a fixed subset of entries (every 7th).
     int checked = 0;
     const double worst = worst_central_difference(
-        atlas, analytic, 0, analytic.size(), 7, [&]() { return objective_value(atlas, targets, c, tape, false); },
-        checked);
+        atlas, analytic, 0, analytic.size(), 7,
+        [&]() { return objective_value(atlas, targets, c, tape, false, w); }, checked);
     INFO("Table 1 row " << row << ": " << checked << " entries, worst error/tolerance " << worst);
     CHECK(checked > 30);
     CHECK(worst <= 1.0);
@@ -202,4 +212,55 @@ TEST_CASE("objective: dense L_6D equals Eq. 7 when the pool is the step's target
   INFO(checked << " entries, worst error/tolerance " << worst_fd);
   CHECK(checked > 30);
   CHECK(worst_fd <= 1.0);
+}
+
+TEST_CASE("objective: values of L_iso and both cycle terms on a linear atlas with an exact inverse", "[objective]") {
+  // Depth 0: phi and psi are affine. phi(u, v) = (a u, b v, 0) + c has the
+  // constant Jacobian J_u = (a, 0, 0), J_v = (0, b, 0), so at every x_P
+  //   L_iso = (a^2 - 1)^2 + (b^2 - 1)^2,
+  // and n = alpha e_3. psi(x, n) = ((x_1 - c_1) / a, (x_2 - c_2) / b) inverts it
+  // on the plane, so with targets on that plane both cycle terms are 0. Adding
+  // d to psi's bias moves every round trip by a known amount:
+  //   L_cycle,2D = |d|^2,  L_cycle,6D = (a d_1)^2 + (b d_2)^2.
+  AtlasOptions ao;
+  ao.gaussians = 16;
+  ao.width = 4;
+  ao.hidden_layers = 0;
+  Atlas<double> atlas(ao);
+  Rng init(21);
+  atlas.initialize(init);
+  const double a = 1.5, b = 0.8, c1 = 0.3, c2 = -0.2;
+  Parameters<double>& p = atlas.params;
+  auto phi_w = p.value(p.find("phi.w0")), phi_b = p.value(p.find("phi.b0"));
+  auto psi_w = p.value(p.find("psi.w0")), psi_b = p.value(p.find("psi.b0"));
+  phi_w << a, 0, 0, 0, b, 0;
+  phi_b << c1, c2, 0;
+  psi_w.setZero();
+  psi_w(0, 0) = 1 / a;
+  psi_w(1, 1) = 1 / b;
+  psi_b << -c1 / a, -c2 / b;
+  const Index m = 30;
+  Block<double> targets(m, 6);
+  Rng rng(22);
+  for (Index i = 0; i < m; ++i)
+    targets.row(i) << a * rng.uniform() + c1, b * rng.uniform() + c2, 0, 0, 0, ao.alpha;
+  auto terms_of = [&]() {
+    Tape<double> t;
+    Rng draws(23);
+    LossTerms terms;
+    single_shape_objective(t, atlas, 0, targets, m, draws, ObjectiveOptions{}, &terms);
+    return terms;
+  };
+  const LossTerms exact = terms_of();
+  const double iso = std::pow(a * a - 1, 2) + std::pow(b * b - 1, 2);
+  CHECK(exact.isometry == Approx(iso).epsilon(1e-13));
+  CHECK(exact.cycle_2d < 1e-28);
+  CHECK(exact.cycle_6d < 1e-28);
+  const double d1 = 0.05, d2 = -0.02;
+  psi_b(0, 0) += d1;
+  psi_b(0, 1) += d2;
+  const LossTerms moved = terms_of();
+  CHECK(moved.cycle_2d == Approx(d1 * d1 + d2 * d2).epsilon(1e-12));
+  CHECK(moved.cycle_6d == Approx(a * a * d1 * d1 + b * b * d2 * d2).epsilon(1e-12));
+  CHECK(moved.isometry == exact.isometry);  // psi does not enter L_iso
 }
