@@ -63,6 +63,13 @@ TEST_CASE("cli: a corrupted or truncated checkpoint is rejected, never half-load
   expect_error("eval " + dir, 1, "model.ckpt");
   write_text(dir + "/model.ckpt", "not a checkpoint");
   expect_error("fit --resume " + dir, 1, "not a jsatlas checkpoint");
+  // A checkpoint of format 1 (before the named sections): the magic, then the
+  // version word 1 where this build writes 2.
+  std::string old = good;
+  old[12] = 1;
+  write_text(dir + "/model.ckpt", old);
+  expect_error("fit --resume " + dir, 1, "checkpoint format 1, this build reads format 2 only (the format changed");
+  expect_error("eval " + dir, 1, "the format changed to named sections");
 }
 
 TEST_CASE("cli: a failing output never damages the file the user had", "[cli]") {

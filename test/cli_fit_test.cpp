@@ -75,6 +75,27 @@ TEST_CASE("cli: a run stopped by SIGTERM and resumed gives the uninterrupted los
   CHECK(loss_rows(c) == loss_rows(a));  // bit for bit: the same trajectory
 }
 
+TEST_CASE("cli: a NaN/Inf fault is undone and reported in losses.csv, config.json and the summary", "[cli]") {
+  // One NaN forced at iteration 63 (hidden test option): the run goes back to
+  // the snapshot of iteration 50, halves the learning rate, redoes 51..63 and
+  // ends at 80 with each iteration logged once.
+  const std::string dir = fresh_dir("fault");
+  Result r = run("fit builtin:sphere -o " + dir + " --iters 80 --inject-fault-at 63" + kSmall);
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  CHECK(r.output.find("it     63: NaN/Inf in the step from iteration 63; restored the state of iteration 50") !=
+        std::string::npos);  // printed even with -q
+  CHECK(r.output.find("fit: 80 iterations, 1 NaN/Inf fault, ") != std::string::npos);
+  CHECK(r.output.find("learning-rate scale now 0.5") != std::string::npos);
+  const std::string config = read_text(dir + "/config.json");
+  CHECK(config.find("\"faults\": 1, \"fault_actions\": [\"NaN/Inf in the step from iteration 63") != std::string::npos);
+  const std::string rows = loss_rows(dir);
+  CHECK(count_lines(rows) == 81);  // 80 iterations and the fault
+  CHECK(rows.find(",1,fault: restored iteration 50; lr scale 0.5\n") != std::string::npos);
+  CHECK(rows.find("\n50,") < rows.find("\n63,"));  // the fault row follows the row it went back to
+  CHECK(rows.find("\n63,") < rows.find("\n51,"));
+}
+
 TEST_CASE("cli: SIGKILL at a random moment leaves a loadable checkpoint", "[cli]") {
   const std::string dir = fresh_dir("kill");
   // Kill in the middle of a run that checkpoints every 5 iterations (0.7 s after

@@ -38,8 +38,11 @@ TEST_CASE("fit config: the paper preset restores the paper's lambdas and keeps t
           "[fit_config]") {
   jsa::FitOptions o;
   REQUIRE(o.weights.cycle == 0.1);  // the laptop default (docs/method.md, "lambda_cycle")
+  REQUIRE(o.orient_every == 100);   // the laptop default: the orientation mirror on
   o.iterations = 7;
   o.seed = 9;
+  o.wrap_steps = 300;  // every heuristic beyond the paper on, to see the preset turn each off
+  o.reseed_every = 250;
   jsa::apply_paper_preset(o);
   const jsa::LossWeights paper;
   CHECK(o.weights.surface == paper.surface);
@@ -52,9 +55,31 @@ TEST_CASE("fit config: the paper preset restores the paper's lambdas and keeps t
   CHECK(o.atlas.alpha == 0.01);
   CHECK(o.atlas.softplus_beta == 0);
   CHECK_FALSE(o.dense_surface);
+  CHECK(o.orient_every == 0);
+  CHECK(o.wrap_steps == 0);
+  CHECK(o.reseed_every == 0);
   CHECK(o.iterations == 7);
   CHECK(o.seed == 9);
   CHECK(jsa::fit_options_to_json(jsa::paper_fit_options()).find("\"cycle\": 1.0") != std::string::npos);
+}
+
+TEST_CASE("fit config: the paper's method (bench_table1) keeps the sizes and turns every heuristic off",
+          "[fit_config]") {
+  jsa::FitOptions o;
+  o.wrap_steps = 300;
+  o.reseed_every = 250;
+  jsa::apply_paper_method(o);
+  const jsa::FitOptions laptop;
+  CHECK(o.atlas.gaussians == laptop.atlas.gaussians);
+  CHECK(o.atlas.width == laptop.atlas.width);
+  CHECK(o.points == laptop.points);
+  CHECK(o.orient_every == 0);
+  CHECK(o.wrap_steps == 0);
+  CHECK(o.reseed_every == 0);
+  CHECK_FALSE(o.dense_surface);
+  CHECK(o.atlas.softplus_beta == 0);
+  CHECK(o.atlas.alpha == 0.01);
+  CHECK(o.weights.cycle == jsa::LossWeights{}.cycle);
 }
 
 TEST_CASE("fit config: settings added later read as what older runs did", "[fit_config]") {

@@ -3,11 +3,14 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
-#include <sstream>
+#include <fstream>
+#include <iterator>
 
 #include "engine/parallel.h"
 #include "model/tool/domain_mesh.h"
+#include "model/tool/loss_log.h"
 #include "model/tool/trainer.h"
+#include "test/scratch.h"
 #include "test/sphere_pool.h"
 
 using namespace jsa;
@@ -53,8 +56,7 @@ TEST_CASE("trainer: a resumed run follows the uninterrupted trajectory", "[train
   }
   Trainer first(small_options(), pool);
   for (int i = 0; i < 4; ++i) first.step();
-  std::stringstream state;
-  first.save_state(state);
+  const TrainerState state = first.save_state();
   Trainer second(small_options(), pool);
   second.load_state(state, "test state");
   REQUIRE(second.iteration() == 4);
@@ -64,16 +66,23 @@ TEST_CASE("trainer: a resumed run follows the uninterrupted trajectory", "[train
   }
 }
 
-TEST_CASE("trainer: a truncated state is rejected", "[trainer]") {
+TEST_CASE("trainer: a truncated or malformed state is rejected", "[trainer]") {
   const Block<double> pool = sphere_pool(1000, 1);
   Trainer t(small_options(), pool);
   t.step();
-  std::stringstream state;
-  t.save_state(state);
-  std::string bytes = state.str();
-  std::stringstream cut(bytes.substr(0, bytes.size() / 2));
+  const TrainerState state = t.save_state();
   Trainer u(small_options(), pool);
-  CHECK_THROWS_AS(u.load_state(cut, "cut"), InputError);
+  for (std::string TrainerState::*part :
+       {&TrainerState::parameters, &TrainerState::optimiser, &TrainerState::rng, &TrainerState::progress}) {
+    TrainerState cut = state;
+    cut.*part = (cut.*part).substr(0, (cut.*part).size() / 2);
+    CHECK_THROWS_AS(u.load_state(cut, "cut"), InputError);
+  }
+  TrainerState bad = state;
+  bad.progress = R"({"iteration": 1e300, "lr_scale": 1, "faults": [], "mirrors": 0, "reseeded": 0})";
+  CHECK_THROWS_AS(u.load_state(bad, "bad"), InputError);
+  u.load_state(state, "whole");
+  CHECK(u.iteration() == 1);
 }
 
 TEST_CASE("trainer: a small atlas learns the unit sphere", "[trainer]") {
@@ -92,19 +101,98 @@ TEST_CASE("trainer: a small atlas learns the unit sphere", "[trainer]") {
 TEST_CASE("trainer: a NaN is caught, the last good state restored, and training goes on", "[trainer]") {
   const Block<double> pool = sphere_pool(4000, 1);
   Trainer t(small_options(), pool);
+  const std::vector<float> initial = t.atlas().params.values();
   for (int i = 0; i < 3; ++i) t.step();
-  const std::vector<float> before = t.atlas().params.values();
   const double lr_before = t.learning_rate();
   t.inject_faults(3, 1);
-  t.step();  // the fault: nothing applied, state restored to the snapshot of iteration 0
-  CHECK(t.iteration() == 3);
+  t.step();  // the fault: nothing applied, the whole state back to the snapshot of iteration 0
+  CHECK(t.iteration() == 0);
   CHECK(t.faults() == 1);
   CHECK(t.learning_rate() == Approx(0.5 * lr_before));
-  CHECK(t.atlas().params.values() != before);  // back at the iteration-0 snapshot, not at 3
-  for (float v : t.atlas().params.values()) REQUIRE(std::isfinite(v));
+  CHECK(t.atlas().params.values() == initial);
   t.step();
-  CHECK(t.iteration() == 4);
+  CHECK(t.iteration() == 1);
   CHECK(std::isfinite(t.last().total));
+}
+
+TEST_CASE("trainer: a fault rewinds counter, schedule, RNG and log to the snapshot, and says so", "[trainer]") {
+  // A fault injected at iteration 73, after the snapshot of iteration 50, with a
+  // decay point at 60: the state, the counter, the draws and the schedule must
+  // all go back to iteration 50, and the log must keep each iteration once.
+  const Block<double> pool = sphere_pool(4000, 1);
+  FitOptions o = small_options();
+  o.iterations = 200;
+  o.decay_at = {0.3};  // lr x 0.1 from iteration 60
+  o.threads = 1;
+  Trainer reference(o, pool);  // the same run without a fault
+  while (reference.iteration() < 50) reference.step();
+  const std::vector<float> params_50 = reference.atlas().params.values();
+  reference.step();  // the step from iteration 50: its loss depends on the params and the draws
+  const double loss_from_50 = reference.last().total;
+
+  Trainer t(o, pool);
+  LossLog log;
+  std::vector<StepReport> reports;
+  t.set_progress([&](const StepReport& r) {
+    record_step(log, r);
+    reports.push_back(r);
+  });
+  while (t.iteration() < 73) t.step();
+  t.inject_faults(73, 1);
+  t.step();
+  REQUIRE(reports.back().fault != nullptr);
+  const FaultRecovery f = *reports.back().fault;
+  CHECK(f.iteration == 73);
+  CHECK(f.restored == 50);
+  CHECK(f.lr_scale == 0.5);
+  CHECK(std::isnan(reports.back().terms.total));
+  CHECK(reports.back().iteration == 50);
+  CHECK(reports.back().faults == 1);
+  CHECK(reports.back().lr == Approx(1e-3 * 0.1));  // the failed step ran past the decay point
+  CHECK(t.iteration() == 50);
+  CHECK(t.atlas().params.values() == params_50);
+  CHECK(t.learning_rate() == Approx(0.5 * 1e-3));  // the schedule at 50, before the decay, halved
+  CHECK(log.rows.back().iteration == 50);           // rows 51..73 were undone
+  CHECK(describe(f).find("restored the state of iteration 50") != std::string::npos);
+
+  t.step();  // the step from 50 again: same parameters and the same draws as the reference
+  CHECK(t.last().total == loss_from_50);
+  CHECK(reports.back().lr == Approx(0.5 * 1e-3));
+  while (t.iteration() < 80) t.step();
+  CHECK(reports.back().lr == Approx(0.5 * 1e-4));  // past the decay point, still halved
+  CHECK(t.faults() == 1);
+  REQUIRE(log.rows.size() == 80);
+  for (size_t i = 0; i < log.rows.size(); ++i) REQUIRE(log.rows[i].iteration == int64_t(i) + 1);
+  CHECK(log.rows[49].faults == 0);
+  CHECK(log.rows[50].faults == 1);
+  REQUIRE(log.faults.size() == 1);
+
+  // losses.csv: the fault row, and the same log read back.
+  const test_support::ScratchDir dir("trainer");
+  const std::string path = dir.path + "/losses.csv";
+  write_loss_log(path, log);
+  std::ifstream in(path);
+  const std::string csv((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  CHECK(csv.find("\n73,") != std::string::npos);
+  CHECK(csv.find(",1,fault: restored iteration 50; lr scale 0.5\n") != std::string::npos);
+  CHECK(csv.find("\n50,") < csv.find("\n73,"));  // after the row it went back to
+  CHECK(csv.find("\n73,") < csv.find("\n51,"));  // before the redone rows
+  const LossLog back = read_loss_log(path, 80);
+  REQUIRE(back.rows.size() == 80);
+  REQUIRE(back.faults.size() == 1);
+  CHECK(back.faults[0].recovery.iteration == 73);
+  CHECK(back.faults[0].recovery.restored == 50);
+  CHECK(back.faults[0].recovery.lr_scale == 0.5);
+  CHECK(std::isnan(back.faults[0].terms.total));
+  CHECK(read_loss_log(path, 80, 0).faults.empty());
+  CHECK(read_loss_log(path, 40).faults.empty());  // it went back to 50, after a checkpoint at 40
+
+  // The checkpointed state carries the fault record and the scale.
+  Trainer resumed(o, pool);
+  resumed.load_state(t.save_state(), "state");
+  CHECK(resumed.faults() == 1);
+  CHECK(resumed.fault_log()[0].restored == 50);
+  CHECK(resumed.learning_rate() == t.learning_rate());
 }
 
 TEST_CASE("trainer: repeated faults stop with NumericalFault", "[trainer]") {
@@ -114,11 +202,31 @@ TEST_CASE("trainer: repeated faults stop with NumericalFault", "[trainer]") {
   Trainer t(o, pool);
   t.step();
   t.inject_faults(1, 100);
-  for (int i = 0; i < 3; ++i) t.step();  // three recoveries
+  // Each fault at 1 goes back to the snapshot of 0, and the step from 0 is
+  // redone; the run never gets past iteration 1, so the faults add up.
+  for (int i = 0; i < 3; ++i) {
+    t.step();  // the fault
+    CHECK(t.iteration() == 0);
+    t.step();  // the redone step from 0
+    CHECK(t.iteration() == 1);
+  }
   CHECK(t.faults() == 3);
-  CHECK_THROWS_AS(t.step(), NumericalFault);  // the fourth in a row gives up
-  CHECK(t.iteration() == 1);
+  CHECK_THROWS_AS(t.step(), NumericalFault);  // the fourth gives up
+  CHECK(t.iteration() == 0);
   for (float v : t.atlas().params.values()) REQUIRE(std::isfinite(v));
+}
+
+TEST_CASE("trainer: errors name settings, not command-line flags", "[trainer]") {
+  const Block<double> pool = sphere_pool(200, 1);
+  FitOptions o = small_options();
+  o.points = 0;
+  CHECK_THROWS_WITH(Trainer(o, pool), "points must be positive");
+  o = small_options();
+  o.fault_lr_factor = 0;
+  CHECK_THROWS_WITH(Trainer(o, pool), "fault_lr_factor must be in (0, 1]");
+  o = small_options();
+  o.weights.cycle = -1;
+  CHECK_THROWS_WITH(Trainer(o, pool), "weights.cycle must be >= 0 and finite");
 }
 
 TEST_CASE("trainer: dense L_6D is seeded and learns the unit sphere", "[trainer]") {

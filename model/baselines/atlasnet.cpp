@@ -42,7 +42,7 @@ AtlasNet<T>::AtlasNet(const AtlasNetOptions& o) : options_(o) {
   if (o.points < p)
     throw InputError("AtlasNet " + o.variant.name() + ": M = " + std::to_string(o.points) +
                      " points cannot cover " + std::to_string(p) +
-                     " patches (give --points >= " + std::to_string(p) + ")");
+                     " patches (points must be >= " + std::to_string(p) + ")");
   const int d = o.shapes > 1 ? o.code_size : 0;
   // alpha = 1: the baselines' loss has no normals; evaluation wants unit ones.
   for (int k = 0; k < p; ++k)
@@ -135,8 +135,8 @@ AtlasNetTrainer::AtlasNetTrainer(const FitOptions& o, const AtlasNetVariant& var
                                  const std::vector<Block<double>>& pools)
     : options_(o), rng_(o.seed, 0) {
   JSA_CHECK(!pools.empty(), "no shapes to fit");
-  if (o.points <= 0) throw InputError("--points must be positive");
-  if (o.iterations < 0) throw InputError("--iters must be >= 0");
+  if (o.points <= 0) throw InputError("points must be positive");
+  if (o.iterations < 0) throw InputError("iterations must be >= 0");
   for (const Block<double>& pool : pools) {
     JSA_CHECK(pool.cols() >= 3 && pool.rows() > 0, "a target pool must be P x 3 or more");
     pools_.push_back(pool.leftCols(3).cast<float>());

@@ -10,8 +10,8 @@
 // (Eq. 2) pointing into the shape: a fold, which no small gradient step undoes
 // (the flap would have to pass through itself). With alpha = 0.01 such a flap
 // costs L_6D (Eq. 7) little, and it shows up as back-facing pairs in the normal
-// metric (on a SHREC ant, ~10% of the surface; per Gaussian the back-facing
-// fraction is bimodal: whole components lie on flaps).
+// metric (a sizeable part of the surface on a SHREC ant, docs/method.md; per
+// Gaussian the back-facing fraction is bimodal: whole components lie on flaps).
 //
 // The mixture P can drop a flap without touching phi: move its components.
 // Every so often we sample S points from each component N(mu_k, sigma^2 I),

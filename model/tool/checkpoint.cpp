@@ -1,10 +1,14 @@
 #include "model/tool/checkpoint.h"
 
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <sstream>
+
+#include <nlohmann/json.hpp>
 
 #include "io/atomic_write.h"
 #include "model/tool/fit_config.h"
@@ -12,8 +16,14 @@
 namespace jsa {
 namespace {
 
+using nlohmann::json;
+
 constexpr char kMagic[12] = {'J', 'S', 'A', 'T', 'L', 'A', 'S', '-', 'C', 'K', 'P', 'T'};
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 2;
+constexpr size_t kNameBytes = 16;
+constexpr size_t kEntryBytes = kNameBytes + 2 * sizeof(uint64_t);
+// Every section a checkpoint must hold, in the order they are written.
+const char* const kSections[] = {"inputs", "settings", "normalisation", "parameters", "optimiser", "rng", "iteration"};
 
 uint64_t fnv1a(const char* p, size_t n) {
   uint64_t h = 1469598103934665603ull;
@@ -24,33 +34,46 @@ uint64_t fnv1a(const char* p, size_t n) {
   return h;
 }
 
-void put_string(std::string& out, const std::string& s) {
-  const uint64_t n = s.size();
-  out.append(reinterpret_cast<const char*>(&n), sizeof n);
-  out.append(s);
+template <class T>
+void append(std::string& out, const T& v) {
+  out.append(reinterpret_cast<const char*>(&v), sizeof v);
 }
 
 }  // namespace
+
+uint64_t checkpoint_checksum(const char* data, size_t size) { return fnv1a(data, size); }
 
 void write_checkpoint(const std::string& path, const std::vector<std::string>& inputs,
                       const FitOptions& options, const std::vector<Normalization>& normalizations,
                       const Trainer& trainer) {
   JSA_CHECK(inputs.size() == normalizations.size() && !inputs.empty(), "one normalisation per input");
+  json frames = json::array();
+  for (const Normalization& n : normalizations)
+    frames.push_back(json{{"center", {n.center(0), n.center(1), n.center(2)}}, {"scale", n.scale}});
+  const TrainerState state = trainer.save_state();
+  const std::map<std::string, std::string> payload = {{"inputs", json(inputs).dump()},
+                                                      {"settings", fit_options_to_json(options, -1)},
+                                                      {"normalisation", frames.dump()},
+                                                      {"parameters", state.parameters},
+                                                      {"optimiser", state.optimiser},
+                                                      {"rng", state.rng},
+                                                      {"iteration", state.progress}};
+  const uint32_t count = uint32_t(std::size(kSections));
   std::string body(kMagic, sizeof kMagic);
-  body.append(reinterpret_cast<const char*>(&kVersion), sizeof kVersion);
-  const uint64_t count = inputs.size();
-  body.append(reinterpret_cast<const char*>(&count), sizeof count);
-  for (const std::string& input : inputs) put_string(body, input);
-  put_string(body, fit_options_to_json(options, -1));
-  for (const Normalization& n : normalizations) {
-    const double norm[4] = {n.center(0), n.center(1), n.center(2), n.scale};
-    body.append(reinterpret_cast<const char*>(norm), sizeof norm);
+  append(body, kVersion);
+  append(body, count);
+  uint64_t offset = body.size() + count * kEntryBytes;
+  for (const char* name : kSections) {
+    char padded[kNameBytes] = {};
+    std::strncpy(padded, name, kNameBytes);
+    body.append(padded, kNameBytes);
+    const uint64_t size = payload.at(name).size();
+    append(body, offset);
+    append(body, size);
+    offset += size;
   }
-  std::ostringstream state;
-  trainer.save_state(state);
-  put_string(body, state.str());
-  const uint64_t sum = fnv1a(body.data(), body.size());
-  body.append(reinterpret_cast<const char*>(&sum), sizeof sum);
+  for (const char* name : kSections) body.append(payload.at(name));
+  append(body, fnv1a(body.data(), body.size()));
   write_file_atomically(path, [&](std::ostream& out) { out.write(body.data(), std::streamsize(body.size())); });
 }
 
@@ -58,56 +81,75 @@ CheckpointContents read_checkpoint(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open checkpoint");
   std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const size_t min_size = sizeof kMagic + sizeof kVersion + sizeof(uint64_t);
-  if (data.size() < min_size || std::memcmp(data.data(), kMagic, sizeof kMagic) != 0)
+  if (data.size() < sizeof kMagic + sizeof kVersion || std::memcmp(data.data(), kMagic, sizeof kMagic) != 0)
     throw InputError(path + ": not a jsatlas checkpoint");
-  uint64_t stored = 0;
-  std::memcpy(&stored, data.data() + data.size() - sizeof stored, sizeof stored);
-  if (fnv1a(data.data(), data.size() - sizeof stored) != stored)
-    throw InputError(path + ": checkpoint is corrupted or truncated (checksum mismatch)");
-  size_t at = sizeof kMagic;
-  const size_t end = data.size() - sizeof stored;
-  auto take = [&](void* p, size_t n) {
-    if (end - at < n) throw InputError(path + ": checkpoint section overruns the file");
-    std::memcpy(p, data.data() + at, n);
-    at += n;
-  };
-  auto take_string = [&]() {
-    uint64_t n = 0;
-    take(&n, sizeof n);
-    if (n > end - at) throw InputError(path + ": checkpoint section overruns the file");
-    std::string s(data.data() + at, n);
-    at += n;
-    return s;
-  };
   uint32_t version = 0;
-  take(&version, sizeof version);
+  std::memcpy(&version, data.data() + sizeof kMagic, sizeof version);
   if (version != kVersion)
-    throw InputError(path + ": checkpoint format " + std::to_string(version) + ", this build reads " +
-                     std::to_string(kVersion));
-  CheckpointContents c;
-  uint64_t count = 0;
-  take(&count, sizeof count);
-  if (count == 0 || count > 100000) throw InputError(path + ": implausible shape count in checkpoint");
-  for (uint64_t i = 0; i < count; ++i) c.inputs.push_back(take_string());
-  c.settings_json = take_string();
-  for (uint64_t i = 0; i < count; ++i) {
-    double norm[4];
-    take(norm, sizeof norm);
-    Normalization n;
-    n.center = Eigen::RowVector3d(norm[0], norm[1], norm[2]);
-    n.scale = norm[3];
-    if (!(n.scale > 0) || !n.center.allFinite()) throw InputError(path + ": bad normalisation in checkpoint");
-    c.normalizations.push_back(n);
+    throw InputError(path + ": checkpoint format " + std::to_string(version) + ", this build reads format " +
+                     std::to_string(kVersion) +
+                     " only (the format changed to named sections; refit, or use the jsatlas that wrote it)");
+  uint64_t stored = 0;
+  if (data.size() < sizeof kMagic + sizeof kVersion + sizeof(uint32_t) + sizeof stored)
+    throw InputError(path + ": checkpoint is truncated");
+  std::memcpy(&stored, data.data() + data.size() - sizeof stored, sizeof stored);
+  const size_t end = data.size() - sizeof stored;
+  if (fnv1a(data.data(), end) != stored)
+    throw InputError(path + ": checkpoint is corrupted or truncated (checksum mismatch)");
+
+  // The table of contents: every section inside the file, back to back, no repeats.
+  size_t at = sizeof kMagic + sizeof kVersion;
+  uint32_t count = 0;
+  std::memcpy(&count, data.data() + at, sizeof count);
+  at += sizeof count;
+  if (count > 64 || (end - at) / kEntryBytes < count) throw InputError(path + ": bad checkpoint table of contents");
+  std::map<std::string, std::string> sections;
+  uint64_t next = at + count * kEntryBytes;
+  for (uint32_t k = 0; k < count; ++k, at += kEntryBytes) {
+    const char* entry = data.data() + at;
+    const std::string name(entry, strnlen(entry, kNameBytes));
+    uint64_t offset = 0, size = 0;
+    std::memcpy(&offset, entry + kNameBytes, sizeof offset);
+    std::memcpy(&size, entry + kNameBytes + sizeof offset, sizeof size);
+    if (offset != next || size > end - offset)
+      throw InputError(path + ": checkpoint section '" + name + "' overruns the file");
+    if (!sections.emplace(name, data.substr(offset, size)).second)
+      throw InputError(path + ": checkpoint section '" + name + "' appears twice");
+    next = offset + size;
   }
-  c.state = take_string();
-  if (at != end) throw InputError(path + ": trailing bytes in checkpoint");
+  if (next != end) throw InputError(path + ": trailing bytes in checkpoint");
+  for (const char* name : kSections)
+    if (!sections.count(name)) throw InputError(path + ": checkpoint lacks the section '" + std::string(name) + "'");
+
+  CheckpointContents c;
+  try {
+    const json inputs = json::parse(sections.at("inputs"));
+    if (!inputs.is_array() || inputs.empty() || inputs.size() > 100000) throw std::runtime_error("one input per shape");
+    for (const json& i : inputs) c.inputs.push_back(i.get<std::string>());
+    const json frames = json::parse(sections.at("normalisation"));
+    if (!frames.is_array() || frames.size() != inputs.size()) throw std::runtime_error("one frame per input");
+    for (const json& f : frames) {
+      const json& center = f.at("center");
+      if (!center.is_array() || center.size() != 3) throw std::runtime_error("a center has 3 coordinates");
+      Normalization n;
+      n.center = Eigen::RowVector3d(center[0].get<double>(), center[1].get<double>(), center[2].get<double>());
+      n.scale = f.at("scale").get<double>();
+      if (!(n.scale > 0) || !std::isfinite(n.scale) || !n.center.allFinite()) throw std::runtime_error("bad frame");
+      c.normalizations.push_back(n);
+    }
+  } catch (const std::exception& e) {
+    throw InputError(path + ": bad inputs or normalisation in checkpoint (" + e.what() + ")");
+  }
+  c.settings_json = sections.at("settings");
+  c.state.parameters = sections.at("parameters");
+  c.state.optimiser = sections.at("optimiser");
+  c.state.rng = sections.at("rng");
+  c.state.progress = sections.at("iteration");
   return c;
 }
 
 void restore_trainer(Trainer& trainer, const CheckpointContents& contents, const std::string& path) {
-  std::istringstream state(contents.state);
-  trainer.load_state(state, path);
+  trainer.load_state(contents.state, path);
 }
 
 std::unique_ptr<Atlas<float>> load_atlas(const CheckpointContents& contents, const std::string& path) {
@@ -115,10 +157,8 @@ std::unique_ptr<Atlas<float>> load_atlas(const CheckpointContents& contents, con
   AtlasOptions ao = o.atlas;
   ao.gaussian_noise = o.components.distribution;
   auto atlas = std::make_unique<Atlas<float>>(ao);
-  // Trainer::save_state: i64 iteration, 4 x u64 RNG, i64 Adam steps, f64 lr scale, parameters.
-  std::istringstream state(contents.state);
-  state.seekg(8 + 32 + 8 + 8);
-  atlas->params.load(state, path);
+  std::istringstream parameters(contents.state.parameters);
+  atlas->params.load(parameters, path);
   return atlas;
 }
 

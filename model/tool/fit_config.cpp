@@ -71,6 +71,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["seed"] = o.seed;
   j["repulsion_tolerance"] = o.repulsion_tolerance;
   j["max_faults"] = o.max_faults;
+  j["fault_lr_factor"] = o.fault_lr_factor;
   j["orient_every"] = o.orient_every;
   j["batch_shapes"] = o.batch_shapes;
   j["wrap_steps"] = o.wrap_steps;
@@ -132,6 +133,7 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   field(j, "", "seed", o.seed);
   field(j, "", "repulsion_tolerance", o.repulsion_tolerance);
   field(j, "", "max_faults", o.max_faults);
+  if (j.contains("fault_lr_factor")) field(j, "", "fault_lr_factor", o.fault_lr_factor);  // later addition: absent = 0.5
   // Added after the first checkpoints were written: a file without them comes
   // from a run that had neither, so absent means 0 (what that run did).
   o.orient_every = 0;
@@ -148,7 +150,7 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (o.atlas.gaussians <= 0 || o.atlas.width <= 0 || o.atlas.hidden_layers < 0 || o.points <= 0 ||
       o.atlas.shapes <= 0 || o.atlas.code_size <= 0 || o.pool <= 0 || o.threads < 0 || o.orient_every < 0 || o.batch_shapes < 0 || o.wrap_steps < 0 || o.reseed_every < 0 || o.atlas.code_layer < 0 || o.atlas.code_layer > 1 || !(o.lr > 0) ||
       !(o.atlas.softplus_beta >= 0) || !std::isfinite(o.atlas.softplus_beta) ||
-      !std::isfinite(o.lr))
+      !std::isfinite(o.lr) || o.max_faults < 0 || !(o.fault_lr_factor > 0 && o.fault_lr_factor <= 1))
     throw InputError(what + ": sizes must be positive");
   // The same bounds as the command line's, so a crafted file cannot make the
   // atlas allocate without limit.
