@@ -64,9 +64,10 @@ void write_checkpoint(const std::string& path, const std::vector<std::string>& i
   append(body, count);
   uint64_t offset = body.size() + count * kEntryBytes;
   for (const char* name : kSections) {
-    char padded[kNameBytes] = {};
-    std::strncpy(padded, name, kNameBytes);
-    body.append(padded, kNameBytes);
+    std::string padded(name);
+    JSA_CHECK(padded.size() < kNameBytes, "checkpoint section name too long: " << name);
+    padded.resize(kNameBytes, '\0');
+    body.append(padded);
     const uint64_t size = payload.at(name).size();
     append(body, offset);
     append(body, size);
