@@ -2,7 +2,6 @@
 // an exact reparametrization (same surface, negated normals, psi still its
 // inverse), and the trainer uses it to turn an inside-out atlas right side out.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
 #include "engine/ops.h"
@@ -18,8 +17,8 @@ namespace {
 AtlasOptions small_atlas() { return test_support::small_atlas(12); }
 }  // namespace
 
-
-TEST_CASE("mirror_domain: the same surface with negated normals; psi stays consistent", "[orientation]") {
+TEST_CASE("mirror_domain: the same surface with negated normals; psi stays consistent",
+          "[orientation]") {
   Atlas<double> atlas(small_atlas());
   Rng init(3);
   atlas.initialize(init);
@@ -32,8 +31,8 @@ TEST_CASE("mirror_domain: the same surface with negated normals; psi stays consi
   Block<double> swapped = uv;
   swapped.col(0).swap(swapped.col(1));
 
-  auto surface = [&](const Block<double>& at, Block<double>& points, Block<double>& normals, Block<double>& chart,
-                     std::vector<double>& density) {
+  auto surface = [&](const Block<double>& at, Block<double>& points, Block<double>& normals,
+                     Block<double>& chart, std::vector<double>& density) {
     Tape<double> t;
     SurfacePoints s = atlas.phi.evaluate(t, atlas.params, t.constant(at), true);
     points = t.value(s.points);
@@ -50,12 +49,13 @@ TEST_CASE("mirror_domain: the same surface with negated normals; psi stays consi
   mirror_domain(atlas, {&moment});
   surface(swapped, p1, n1, c1, d1);
 
-  CHECK((p1 - p0).cwiseAbs().maxCoeff() < 1e-12);        // phi'(v, u) = phi(u, v)
-  CHECK((n1 + n0).cwiseAbs().maxCoeff() < 1e-12);        // n' = -n
-  CHECK(n0.cwiseAbs().maxCoeff() > 1e-3);                // (and the normals are not zero)
+  CHECK((p1 - p0).cwiseAbs().maxCoeff() < 1e-12);                // phi'(v, u) = phi(u, v)
+  CHECK((n1 + n0).cwiseAbs().maxCoeff() < 1e-12);                // n' = -n
+  CHECK(n0.cwiseAbs().maxCoeff() > 1e-3);                        // (and the normals are not zero)
   CHECK((c1.col(0) - c0.col(1)).cwiseAbs().maxCoeff() < 1e-12);  // psi' = swap(psi)
   CHECK((c1.col(1) - c0.col(0)).cwiseAbs().maxCoeff() < 1e-12);
-  for (size_t i = 0; i < d0.size(); ++i) CHECK(d1[i] == Approx(d0[i]).epsilon(1e-12));  // P' = mirrored P
+  for (size_t i = 0; i < d0.size(); ++i)
+    CHECK(d1[i] == Approx(d0[i]).epsilon(1e-12));  // P' = mirrored P
   CHECK(moment != moment_before);  // the aligned buffer moved with the parameters...
   mirror_domain(atlas, {&moment});
   CHECK(moment == moment_before);  // ...and mirroring twice is the identity
@@ -112,7 +112,8 @@ TEST_CASE("trainer: an inside-out start is mirrored, an outside-out one is not",
   CHECK(inside_out == 1);
 }
 
-TEST_CASE("mirror_domain: psi' = swap(psi) for every depth and code layer the CLI accepts", "[orientation]") {
+TEST_CASE("mirror_domain: psi' = swap(psi) for every depth and code layer the CLI accepts",
+          "[orientation]") {
   // `jsatlas fit` accepts --depth 1..32 and --code-layer 0..1 (bin/fit_command.cpp;
   // a checkpoint's settings also allow depth 0, model/fit_config.cpp); codes
   // exist only for collections (shapes > 1). Where the code enters psi's output
@@ -122,7 +123,8 @@ TEST_CASE("mirror_domain: psi' = swap(psi) for every depth and code layer the CL
   for (int depth = 0; depth <= 32; ++depth)
     for (int code_layer = 0; code_layer <= 1; ++code_layer)
       for (int shapes : {1, 3}) {
-        if (code_layer == 1 && (depth == 0 || shapes == 1)) continue;  // no layer after the first / no codes
+        if (code_layer == 1 && (depth == 0 || shapes == 1))
+          continue;  // no layer after the first / no codes
         AtlasOptions ao;
         ao.gaussians = 4;
         ao.width = 4;
@@ -147,17 +149,20 @@ TEST_CASE("mirror_domain: psi' = swap(psi) for every depth and code layer the CL
           for (int c = 0; c < 6; ++c) x6(i, c) = rng.uniform(-1, 1);
         auto chart = [&](int shape) {
           Tape<double> t;
-          return Block<double>(t.value(atlas.psi.evaluate(t, atlas.params, t.constant(x6), atlas.psi_code(t, shape))));
+          return Block<double>(t.value(
+              atlas.psi.evaluate(t, atlas.params, t.constant(x6), atlas.psi_code(t, shape))));
         };
         std::vector<Block<double>> before;
         for (int s = 0; s < shapes; ++s) before.push_back(chart(s));
         mirror_domain(atlas);
         for (int s = 0; s < shapes; ++s) {
           const Block<double> after = chart(s);
-          INFO("depth " << depth << ", code layer " << code_layer << ", shapes " << shapes << ", shape " << s);
+          INFO("depth " << depth << ", code layer " << code_layer << ", shapes " << shapes
+                        << ", shape " << s);
           CHECK((after.col(0) - before[size_t(s)].col(1)).cwiseAbs().maxCoeff() < 1e-12);
           CHECK((after.col(1) - before[size_t(s)].col(0)).cwiseAbs().maxCoeff() < 1e-12);
-          CHECK((before[size_t(s)].col(0) - before[size_t(s)].col(1)).cwiseAbs().maxCoeff() > 1e-6);  // not trivially symmetric
+          CHECK((before[size_t(s)].col(0) - before[size_t(s)].col(1)).cwiseAbs().maxCoeff() >
+                1e-6);  // not trivially symmetric
         }
         ++cases;
       }

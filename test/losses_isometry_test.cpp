@@ -2,7 +2,6 @@
 // known: zero for an isometry, the closed form for a stretch and a shear. (Its
 // gradients are checked with the MLP's tangents in engine_tangents_test.cpp.)
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
 #include "engine/rng.h"
@@ -26,7 +25,8 @@ TEST_CASE("isometry_loss: 0 for an isometry (orthonormal J_u, J_v)", "[isometry]
   const Index m = 50;
   Block<double> du(m, 3), dv(m, 3);
   for (Index i = 0; i < m; ++i) {
-    Eigen::Vector3d a(rng.normal(), rng.normal(), rng.normal()), b(rng.normal(), rng.normal(), rng.normal());
+    Eigen::Vector3d a(rng.normal(), rng.normal(), rng.normal()),
+        b(rng.normal(), rng.normal(), rng.normal());
     a.normalize();
     b = (b - b.dot(a) * a).normalized();
     du.row(i) = a.transpose();

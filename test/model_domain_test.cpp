@@ -5,7 +5,6 @@
 // and the draws are seeded, so the outcome is fixed; a wrong sigma or a biased
 // choice of component fails them by far.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
 #include "engine/tape.h"
@@ -13,7 +12,8 @@
 
 using namespace jsa;
 
-TEST_CASE("Domain::sample: uniform components, per-component spread sigma = 1/sqrt(K)", "[domain]") {
+TEST_CASE("Domain::sample: uniform components, per-component spread sigma = 1/sqrt(K)",
+          "[domain]") {
   const int k = 16;
   const Index n = 160000;  // 10^4 samples per component
   Parameters<double> params;
@@ -76,5 +76,6 @@ TEST_CASE("Domain::sample without noise returns the means themselves", "[domain]
   std::vector<int> component;
   const Block<double> x = t.value(domain.sample(t, params, 100, rng, &component));
   const auto mu = params.value(domain.means());
-  for (Index m = 0; m < x.rows(); ++m) REQUIRE((x.row(m) - mu.row(component[size_t(m)])).norm() == 0.0);
+  for (Index m = 0; m < x.rows(); ++m)
+    REQUIRE((x.row(m) - mu.row(component[size_t(m)])).norm() == 0.0);
 }

@@ -1,7 +1,6 @@
 // The training loop: same seed -> same run; a resumed run follows the same
 // trajectory bit for bit; and a small atlas actually learns a sphere.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -72,14 +71,15 @@ TEST_CASE("trainer: a truncated or malformed state is rejected", "[trainer]") {
   t.step();
   const TrainerState state = t.save_state();
   Trainer u(small_options(), pool);
-  for (std::string TrainerState::*part :
-       {&TrainerState::parameters, &TrainerState::optimiser, &TrainerState::rng, &TrainerState::progress}) {
+  for (std::string TrainerState::*part : {&TrainerState::parameters, &TrainerState::optimiser,
+                                          &TrainerState::rng, &TrainerState::progress}) {
     TrainerState cut = state;
     cut.*part = (cut.*part).substr(0, (cut.*part).size() / 2);
     CHECK_THROWS_AS(u.load_state(cut, "cut"), InputError);
   }
   TrainerState bad = state;
-  bad.progress = R"({"iteration": 1e300, "lr_scale": 1, "faults": [], "mirrors": 0, "reseeded": 0})";
+  bad.progress =
+      R"({"iteration": 1e300, "lr_scale": 1, "faults": [], "mirrors": 0, "reseeded": 0})";
   CHECK_THROWS_AS(u.load_state(bad, "bad"), InputError);
   u.load_state(state, "whole");
   CHECK(u.iteration() == 1);
@@ -98,7 +98,8 @@ TEST_CASE("trainer: a small atlas learns the unit sphere", "[trainer]") {
   CHECK(final_6d < 0.1);
 }
 
-TEST_CASE("trainer: a NaN is caught, the last good state restored, and training goes on", "[trainer]") {
+TEST_CASE("trainer: a NaN is caught, the last good state restored, and training goes on",
+          "[trainer]") {
   const Block<double> pool = sphere_pool(4000, 1);
   Trainer t(small_options(), pool);
   const std::vector<float> initial = t.atlas().params.values();
@@ -115,7 +116,8 @@ TEST_CASE("trainer: a NaN is caught, the last good state restored, and training 
   CHECK(std::isfinite(t.last().total));
 }
 
-TEST_CASE("trainer: a fault rewinds counter, schedule, RNG and log to the snapshot, and says so", "[trainer]") {
+TEST_CASE("trainer: a fault rewinds counter, schedule, RNG and log to the snapshot, and says so",
+          "[trainer]") {
   // A fault injected at iteration 73, after the snapshot of iteration 50, with a
   // decay point at 60: the state, the counter, the draws and the schedule must
   // all go back to iteration 50, and the log must keep each iteration once.
@@ -152,7 +154,7 @@ TEST_CASE("trainer: a fault rewinds counter, schedule, RNG and log to the snapsh
   CHECK(t.iteration() == 50);
   CHECK(t.atlas().params.values() == params_50);
   CHECK(t.learning_rate() == Approx(0.5 * 1e-3));  // the schedule at 50, before the decay, halved
-  CHECK(log.rows.back().iteration == 50);           // rows 51..73 were undone
+  CHECK(log.rows.back().iteration == 50);          // rows 51..73 were undone
   CHECK(describe(f).find("restored the state of iteration 50") != std::string::npos);
 
   t.step();  // the step from 50 again: same parameters and the same draws as the reference

@@ -33,7 +33,8 @@ void mirror_domain(Atlas<T>& atlas, const std::vector<std::vector<T>*>& aligned)
   // With latent codes, f W_f is added to the pre-activation of layer code_layer
   // (model/mlp.h). When that layer is psi's output layer (depth 1 with
   // code_layer 1, or depth 0), W_f's columns are psi's outputs (u, v) too.
-  const int psi_wf = atlas.has_codes() && atlas.options().code_layer == psi_out ? p.find("psi.wf") : -1;
+  const int psi_wf =
+      atlas.has_codes() && atlas.options().code_layer == psi_out ? p.find("psi.wf") : -1;
   JSA_CHECK(psi_wf >= 0 || !atlas.has_codes() || atlas.options().code_layer < psi_out,
             "mirror_domain: the atlas lacks psi's code weights");
   std::vector<std::vector<T>*> buffers{&p.values()};

@@ -6,9 +6,8 @@
 #include <fstream>
 #include <map>
 #include <memory>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "io/atomic_write.h"
 #include "model/tool/fit_config.h"
@@ -23,7 +22,8 @@ constexpr uint32_t kVersion = 2;
 constexpr size_t kNameBytes = 16;
 constexpr size_t kEntryBytes = kNameBytes + 2 * sizeof(uint64_t);
 // Every section a checkpoint must hold, in the order they are written.
-const char* const kSections[] = {"inputs", "settings", "normalisation", "parameters", "optimiser", "rng", "iteration"};
+const char* const kSections[] = {"inputs",    "settings", "normalisation", "parameters",
+                                 "optimiser", "rng",      "iteration"};
 
 uint64_t fnv1a(const char* p, size_t n) {
   uint64_t h = 1469598103934665603ull;
@@ -46,18 +46,17 @@ uint64_t checkpoint_checksum(const char* data, size_t size) { return fnv1a(data,
 void write_checkpoint(const std::string& path, const std::vector<std::string>& inputs,
                       const FitOptions& options, const std::vector<Normalization>& normalizations,
                       const Trainer& trainer) {
-  JSA_CHECK(inputs.size() == normalizations.size() && !inputs.empty(), "one normalisation per input");
+  JSA_CHECK(inputs.size() == normalizations.size() && !inputs.empty(),
+            "one normalisation per input");
   json frames = json::array();
   for (const Normalization& n : normalizations)
     frames.push_back(json{{"center", {n.center(0), n.center(1), n.center(2)}}, {"scale", n.scale}});
   const TrainerState state = trainer.save_state();
-  const std::map<std::string, std::string> payload = {{"inputs", json(inputs).dump()},
-                                                      {"settings", fit_options_to_json(options, -1)},
-                                                      {"normalisation", frames.dump()},
-                                                      {"parameters", state.parameters},
-                                                      {"optimiser", state.optimiser},
-                                                      {"rng", state.rng},
-                                                      {"iteration", state.progress}};
+  const std::map<std::string, std::string> payload = {
+      {"inputs", json(inputs).dump()},  {"settings", fit_options_to_json(options, -1)},
+      {"normalisation", frames.dump()}, {"parameters", state.parameters},
+      {"optimiser", state.optimiser},   {"rng", state.rng},
+      {"iteration", state.progress}};
   const uint32_t count = uint32_t(std::size(kSections));
   std::string body(kMagic, sizeof kMagic);
   append(body, kVersion);
@@ -75,21 +74,24 @@ void write_checkpoint(const std::string& path, const std::vector<std::string>& i
   }
   for (const char* name : kSections) body.append(payload.at(name));
   append(body, fnv1a(body.data(), body.size()));
-  write_file_atomically(path, [&](std::ostream& out) { out.write(body.data(), std::streamsize(body.size())); });
+  write_file_atomically(
+      path, [&](std::ostream& out) { out.write(body.data(), std::streamsize(body.size())); });
 }
 
 CheckpointContents read_checkpoint(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open checkpoint");
   std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (data.size() < sizeof kMagic + sizeof kVersion || std::memcmp(data.data(), kMagic, sizeof kMagic) != 0)
+  if (data.size() < sizeof kMagic + sizeof kVersion ||
+      std::memcmp(data.data(), kMagic, sizeof kMagic) != 0)
     throw InputError(path + ": not a jsatlas checkpoint");
   uint32_t version = 0;
   std::memcpy(&version, data.data() + sizeof kMagic, sizeof version);
   if (version != kVersion)
-    throw InputError(path + ": checkpoint format " + std::to_string(version) + ", this build reads format " +
-                     std::to_string(kVersion) +
-                     " only (the format changed to named sections; refit, or use the jsatlas that wrote it)");
+    throw InputError(
+        path + ": checkpoint format " + std::to_string(version) + ", this build reads format " +
+        std::to_string(kVersion) +
+        " only (the format changed to named sections; refit, or use the jsatlas that wrote it)");
   uint64_t stored = 0;
   if (data.size() < sizeof kMagic + sizeof kVersion + sizeof(uint32_t) + sizeof stored)
     throw InputError(path + ": checkpoint is truncated");
@@ -103,7 +105,8 @@ CheckpointContents read_checkpoint(const std::string& path) {
   uint32_t count = 0;
   std::memcpy(&count, data.data() + at, sizeof count);
   at += sizeof count;
-  if (count > 64 || (end - at) / kEntryBytes < count) throw InputError(path + ": bad checkpoint table of contents");
+  if (count > 64 || (end - at) / kEntryBytes < count)
+    throw InputError(path + ": bad checkpoint table of contents");
   std::map<std::string, std::string> sections;
   uint64_t next = at + count * kEntryBytes;
   for (uint32_t k = 0; k < count; ++k, at += kEntryBytes) {
@@ -120,22 +123,28 @@ CheckpointContents read_checkpoint(const std::string& path) {
   }
   if (next != end) throw InputError(path + ": trailing bytes in checkpoint");
   for (const char* name : kSections)
-    if (!sections.count(name)) throw InputError(path + ": checkpoint lacks the section '" + std::string(name) + "'");
+    if (!sections.count(name))
+      throw InputError(path + ": checkpoint lacks the section '" + std::string(name) + "'");
 
   CheckpointContents c;
   try {
     const json inputs = json::parse(sections.at("inputs"));
-    if (!inputs.is_array() || inputs.empty() || inputs.size() > 100000) throw std::runtime_error("one input per shape");
+    if (!inputs.is_array() || inputs.empty() || inputs.size() > 100000)
+      throw std::runtime_error("one input per shape");
     for (const json& i : inputs) c.inputs.push_back(i.get<std::string>());
     const json frames = json::parse(sections.at("normalisation"));
-    if (!frames.is_array() || frames.size() != inputs.size()) throw std::runtime_error("one frame per input");
+    if (!frames.is_array() || frames.size() != inputs.size())
+      throw std::runtime_error("one frame per input");
     for (const json& f : frames) {
       const json& center = f.at("center");
-      if (!center.is_array() || center.size() != 3) throw std::runtime_error("a center has 3 coordinates");
+      if (!center.is_array() || center.size() != 3)
+        throw std::runtime_error("a center has 3 coordinates");
       Normalization n;
-      n.center = Eigen::RowVector3d(center[0].get<double>(), center[1].get<double>(), center[2].get<double>());
+      n.center = Eigen::RowVector3d(center[0].get<double>(), center[1].get<double>(),
+                                    center[2].get<double>());
       n.scale = f.at("scale").get<double>();
-      if (!(n.scale > 0) || !std::isfinite(n.scale) || !n.center.allFinite()) throw std::runtime_error("bad frame");
+      if (!(n.scale > 0) || !std::isfinite(n.scale) || !n.center.allFinite())
+        throw std::runtime_error("bad frame");
       c.normalizations.push_back(n);
     }
   } catch (const std::exception& e) {
@@ -149,11 +158,13 @@ CheckpointContents read_checkpoint(const std::string& path) {
   return c;
 }
 
-void restore_trainer(Trainer& trainer, const CheckpointContents& contents, const std::string& path) {
+void restore_trainer(Trainer& trainer, const CheckpointContents& contents,
+                     const std::string& path) {
   trainer.load_state(contents.state, path);
 }
 
-std::unique_ptr<Atlas<float>> load_atlas(const CheckpointContents& contents, const std::string& path) {
+std::unique_ptr<Atlas<float>> load_atlas(const CheckpointContents& contents,
+                                         const std::string& path) {
   const FitOptions o = fit_options_from_json(contents.settings_json, path);
   AtlasOptions ao = o.atlas;
   ao.gaussian_noise = o.components.distribution;

@@ -27,10 +27,10 @@
 namespace jsa {
 
 struct CheckpointContents {
-  std::vector<std::string> inputs;           // what was fitted: paths or "builtin:NAME", one per shape
-  std::string settings_json;                 // fit_options_to_json of the run
-  std::vector<Normalization> normalizations; // input frame -> unit frame, one per shape
-  TrainerState state;                        // parameters, optimiser, RNG, iteration
+  std::vector<std::string> inputs;  // what was fitted: paths or "builtin:NAME", one per shape
+  std::string settings_json;        // fit_options_to_json of the run
+  std::vector<Normalization> normalizations;  // input frame -> unit frame, one per shape
+  TrainerState state;                         // parameters, optimiser, RNG, iteration
 };
 
 void write_checkpoint(const std::string& path, const std::vector<std::string>& inputs,
@@ -44,6 +44,7 @@ uint64_t checkpoint_checksum(const char* data, size_t size);
 // Restores a trainer built from contents.settings_json.
 void restore_trainer(Trainer& trainer, const CheckpointContents& contents, const std::string& path);
 // The atlas alone (no optimiser), for the commands that use a finished run.
-std::unique_ptr<Atlas<float>> load_atlas(const CheckpointContents& contents, const std::string& path);
+std::unique_ptr<Atlas<float>> load_atlas(const CheckpointContents& contents,
+                                         const std::string& path);
 
 }  // namespace jsa

@@ -31,8 +31,8 @@ void write_loss_log(const std::string& path, const LossLog& log) {
     out << kHeader << "\n";
     out.precision(8);
     auto terms = [&](const LossTerms& t) {
-      out << t.total << "," << t.surface << "," << t.chart << "," << t.cycle_2d << "," << t.cycle_6d << ","
-          << t.isometry << "," << t.repulsion;
+      out << t.total << "," << t.surface << "," << t.chart << "," << t.cycle_2d << "," << t.cycle_6d
+          << "," << t.isometry << "," << t.repulsion;
     };
     size_t f = 0;
     auto faults_up_to = [&](int64_t iteration) {  // the faults that went back to <= iteration
@@ -78,7 +78,8 @@ LossLog read_loss_log(const std::string& path, int64_t up_to, int max_faults) {
       if (fields[k].empty() || *end != '\0') throw InputError(where + ": malformed loss row");
     }
     // The counts as integers (a cast of NaN or 1e300 would be undefined).
-    if (!(v[0] >= 0 && v[0] < 1e15 && v[9] >= 0 && v[9] < 1e9)) throw InputError(where + ": malformed loss row");
+    if (!(v[0] >= 0 && v[0] < 1e15 && v[9] >= 0 && v[9] < 1e9))
+      throw InputError(where + ": malformed loss row");
     const LossTerms terms{v[2], v[3], v[4], v[5], v[6], v[7], v[8]};
     const std::string event = fields.size() == 11 ? fields[10] : std::string();
     if (event.empty()) {

@@ -17,8 +17,8 @@ struct LossLog {
     int faults = 0;  // recoveries before this row
   };
   struct Fault {
-    double lr;          // the learning rate of the failed step
-    LossTerms terms;    // what it computed (a NaN or Inf somewhere)
+    double lr;        // the learning rate of the failed step
+    LossTerms terms;  // what it computed (a NaN or Inf somewhere)
     FaultRecovery recovery;
   };
   std::vector<Row> rows;      // one per iteration kept, increasing

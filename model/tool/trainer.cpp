@@ -7,9 +7,8 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "model/heuristics/orientation.h"
 #include "model/heuristics/reseed.h"
@@ -27,11 +26,15 @@ static void validate(const FitOptions& o) {
   require(o.lr > 0 && std::isfinite(o.lr), "lr must be positive and finite");
   require(o.decay >= 0 && o.decay <= 1, "decay must be in [0, 1]");
   for (double f : o.decay_at) require(f >= 0 && f <= 1, "decay_at must be fractions in [0, 1]");
-  require(o.atlas.alpha > 0 && std::isfinite(o.atlas.alpha), "atlas.alpha must be positive and finite");
+  require(o.atlas.alpha > 0 && std::isfinite(o.atlas.alpha),
+          "atlas.alpha must be positive and finite");
   const std::pair<double, const char*> weights[] = {
-      {o.weights.surface, "weights.surface_6d must be >= 0 and finite"},   {o.weights.chart, "weights.chart_2d must be >= 0 and finite"},
-      {o.weights.cycle, "weights.cycle must be >= 0 and finite"},  {o.weights.isometry, "weights.isometry must be >= 0 and finite"},
-      {o.weights.repulsion, "weights.repulsion must be >= 0 and finite"}, {o.weights.code, "weights.code must be >= 0 and finite"}};
+      {o.weights.surface, "weights.surface_6d must be >= 0 and finite"},
+      {o.weights.chart, "weights.chart_2d must be >= 0 and finite"},
+      {o.weights.cycle, "weights.cycle must be >= 0 and finite"},
+      {o.weights.isometry, "weights.isometry must be >= 0 and finite"},
+      {o.weights.repulsion, "weights.repulsion must be >= 0 and finite"},
+      {o.weights.code, "weights.code must be >= 0 and finite"}};
   for (const auto& [w, message] : weights) require(w >= 0 && std::isfinite(w), message);
   require(o.repulsion_tolerance > 0, "repulsion_tolerance must be positive");
   require(o.orient_every >= 0 && o.reseed_every >= 0 && o.wrap_steps >= 0,
@@ -49,7 +52,8 @@ Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools)
     pools_.push_back(pool.cast<float>());
     pools_.back().rightCols(3) *= float(o.atlas.alpha);
     if (o.dense_surface)
-      surfaces_.emplace_back(o.components.normals ? pools_.back() : Block<float>(pools_.back().leftCols(3)));
+      surfaces_.emplace_back(o.components.normals ? pools_.back()
+                                                  : Block<float>(pools_.back().leftCols(3)));
   }
   const int n = int(pools.size());
   const int b = o.batch_shapes > 0 && o.batch_shapes < n ? o.batch_shapes : n;
@@ -73,7 +77,8 @@ std::string describe(const FaultRecovery& f) {
 
 double Trainer::learning_rate() const {
   std::vector<int64_t> milestones;
-  for (double f : options_.decay_at) milestones.push_back(int64_t(std::llround(f * double(options_.iterations))));
+  for (double f : options_.decay_at)
+    milestones.push_back(int64_t(std::llround(f * double(options_.iterations))));
   return lr_scale_ * step_decay(options_.lr, iteration_, milestones, options_.decay);
 }
 
@@ -99,8 +104,8 @@ WrapReport Trainer::wrap(const std::function<bool()>& cancelled) {
   if (wrapped_ || iteration_ > 0 || options_.wrap_steps <= 0) return {};
   wrapped_ = true;
   Rng rng(options_.seed, 2);  // its own stream: the training draws are the same with or without it
-  const WrapReport r =
-      wrap_initialize(*atlas_, pools_, options_.wrap_steps, options_.points, options_.lr, rng, cancelled);
+  const WrapReport r = wrap_initialize(*atlas_, pools_, options_.wrap_steps, options_.points,
+                                       options_.lr, rng, cancelled);
   take_snapshot(rng_.state());  // a fault must not undo the wrap
   return r;
 }
@@ -116,18 +121,21 @@ void Trainer::step() {
     // A uniform subset of B shapes: the first B of a partial Fisher-Yates shuffle.
     std::vector<int> order(static_cast<size_t>(n));
     for (int i = 0; i < n; ++i) order[size_t(i)] = i;
-    for (int i = 0; i < b; ++i) std::swap(order[size_t(i)], order[size_t(i) + rng_.below(uint64_t(n - i))]);
+    for (int i = 0; i < b; ++i)
+      std::swap(order[size_t(i)], order[size_t(i) + rng_.below(uint64_t(n - i))]);
     batch_.assign(order.begin(), order.begin() + b);
   }
   // M targets {x_S, n_S} per shape of the batch, drawn with replacement from its pool.
   for (int k = 0; k < b; ++k) {
     const Block<float>& pool = pools_[size_t(batch_[size_t(k)])];
-    for (Index m = 0; m < options_.points; ++m) targets_[size_t(k)].row(m) = pool.row(Index(rng_.below(uint64_t(pool.rows()))));
+    for (Index m = 0; m < options_.points; ++m)
+      targets_[size_t(k)].row(m) = pool.row(Index(rng_.below(uint64_t(pool.rows()))));
   }
   tape_.clear();
-  const ObjectiveOptions objective{options_.weights, options_.components, options_.repulsion_tolerance};
-  Var loss = collection_objective(tape_, *atlas_, targets_, options_.points, rng_, objective, &last_,
-                                  b < n ? batch_ : std::vector<int>{}, surfaces_);
+  const ObjectiveOptions objective{options_.weights, options_.components,
+                                   options_.repulsion_tolerance};
+  Var loss = collection_objective(tape_, *atlas_, targets_, options_.points, rng_, objective,
+                                  &last_, b < n ? batch_ : std::vector<int>{}, surfaces_);
   atlas_->params.zero_grad();
   tape_.backward(loss);
   if (iteration_ == fault_at_ && faults_to_inject_ > 0) {
@@ -168,7 +176,8 @@ void Trainer::step() {
   report.reseeded_total = reseeded_;
   report.elapsed = elapsed_;
   if (progress_) progress_(report);
-  if (unresolved_faults_ > options_.max_faults) throw NumericalFault(unresolved_faults_, failed_iteration_);
+  if (unresolved_faults_ > options_.max_faults)
+    throw NumericalFault(unresolved_faults_, failed_iteration_);
 }
 
 bool Trainer::choose_orientation() {
@@ -180,7 +189,8 @@ bool Trainer::choose_orientation() {
   Rng rng(options_.seed, 1000 + uint64_t(iteration_ / every));
   double back = 0;
   for (size_t i = 0; i < targets_.size(); ++i)
-    back += back_facing_fraction(*atlas_, targets_[i], std::min<Index>(options_.points, 2000), rng, batch_[i]);
+    back += back_facing_fraction(*atlas_, targets_[i], std::min<Index>(options_.points, 2000), rng,
+                                 batch_[i]);
   if (back / double(targets_.size()) <= 0.5) return false;
   mirror_domain(*atlas_, {&adam_.first_moment(), &adam_.second_moment()});
   ++mirrors_;
@@ -205,8 +215,8 @@ int Trainer::reseed() {
     for (Index m = 0; m < count; ++m) t.row(m) = pool.row(Index(rng.below(uint64_t(pool.rows()))));
     targets.push_back(std::move(t));
   }
-  const ReseedReport r =
-      reseed_flipped_means(*atlas_, targets, batch_, rng, {&adam_.first_moment(), &adam_.second_moment()});
+  const ReseedReport r = reseed_flipped_means(*atlas_, targets, batch_, rng,
+                                              {&adam_.first_moment(), &adam_.second_moment()});
   if (r.flipped == 0) return 0;
   reseeded_ += r.flipped;
   take_snapshot(rng_.state());
@@ -229,20 +239,23 @@ TrainerState Trainer::save_state() const {
   st.rng = nlohmann::json{{"xoshiro256", rng_.state()}}.dump();
   nlohmann::json faults = nlohmann::json::array();
   for (const FaultRecovery& f : fault_log_)
-    faults.push_back(nlohmann::json{{"iteration", f.iteration}, {"restored", f.restored}, {"lr_scale", f.lr_scale}});
-  st.progress = nlohmann::json{{"iteration", iteration_},
-                               {"lr_scale", lr_scale_},
-                               {"faults", faults},
-                               {"mirrors", mirrors_},
-                               {"reseeded", reseeded_}}
-                    .dump();
+    faults.push_back(nlohmann::json{
+        {"iteration", f.iteration}, {"restored", f.restored}, {"lr_scale", f.lr_scale}});
+  st.progress = nlohmann::json{
+      {"iteration", iteration_},
+      {"lr_scale", lr_scale_},
+      {"faults", faults},
+      {"mirrors", mirrors_},
+      {"reseeded",
+       reseeded_}}.dump();
   return st;
 }
 
 void Trainer::load_state(const TrainerState& st, const std::string& what) {
   std::istringstream params(st.parameters);
   atlas_->params.load(params, what);
-  if (params.peek() != std::char_traits<char>::eof()) throw InputError(what + ": trailing bytes after the parameters");
+  if (params.peek() != std::char_traits<char>::eof())
+    throw InputError(what + ": trailing bytes after the parameters");
   size_t at = 0;
   auto get = [&](void* p, size_t n) {
     if (st.optimiser.size() - at < n) throw InputError(what + ": truncated optimiser state");
@@ -255,7 +268,8 @@ void Trainer::load_state(const TrainerState& st, const std::string& what) {
   for (std::vector<float>& v : moments) {
     uint64_t n = 0;
     get(&n, sizeof n);
-    if (n != 0 && n != atlas_->params.size()) throw InputError(what + ": Adam state does not match the model");
+    if (n != 0 && n != atlas_->params.size())
+      throw InputError(what + ": Adam state does not match the model");
     v.resize(n);
     get(v.data(), sizeof(float) * n);
   }
@@ -269,14 +283,16 @@ void Trainer::load_state(const TrainerState& st, const std::string& what) {
     const nlohmann::json r = nlohmann::json::parse(st.rng), p = nlohmann::json::parse(st.progress);
     // Integers only: nlohmann converts a float such as 1e300 with static_cast (undefined).
     auto integer = [](const nlohmann::json& v) {
-      if (!v.is_number_integer() || (v.is_number_unsigned() && v.get<uint64_t>() > uint64_t(INT64_MAX)))
+      if (!v.is_number_integer() ||
+          (v.is_number_unsigned() && v.get<uint64_t>() > uint64_t(INT64_MAX)))
         throw std::runtime_error("expected an integer");
       return v.get<int64_t>();
     };
     const nlohmann::json& words = r.at("xoshiro256");
     if (!words.is_array() || words.size() != 4) throw std::runtime_error("expected 4 state words");
     for (size_t i = 0; i < 4; ++i) {
-      if (!words[i].is_number_unsigned()) throw std::runtime_error("expected an unsigned state word");
+      if (!words[i].is_number_unsigned())
+        throw std::runtime_error("expected an unsigned state word");
       s[i] = words[i].get<uint64_t>();
     }
     it = integer(p.at("iteration"));
@@ -286,12 +302,14 @@ void Trainer::load_state(const TrainerState& st, const std::string& what) {
     reseeded = int(std::clamp<int64_t>(integer(p.at("reseeded")), -1, INT32_MAX));
     for (const nlohmann::json& f : p.at("faults")) {
       if (!f.at("lr_scale").is_number()) throw std::runtime_error("expected a number");
-      faults.push_back({integer(f.at("iteration")), integer(f.at("restored")), f.at("lr_scale").get<double>()});
+      faults.push_back(
+          {integer(f.at("iteration")), integer(f.at("restored")), f.at("lr_scale").get<double>()});
     }
   } catch (const std::exception& e) {
     throw InputError(what + ": malformed RNG or progress state (" + e.what() + ")");
   }
-  if (it < 0 || steps < 0 || mirrors < 0 || reseeded < 0) throw InputError(what + ": negative count in the training state");
+  if (it < 0 || steps < 0 || mirrors < 0 || reseeded < 0)
+    throw InputError(what + ": negative count in the training state");
   if (!(scale > 0 && scale <= 1)) throw InputError(what + ": bad learning-rate scale");
   iteration_ = it;
   rng_.set_state(s);

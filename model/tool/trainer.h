@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "engine/adam.h"
-#include "model/objective.h"
 #include "model/heuristics/wrap.h"
+#include "model/objective.h"
 
 namespace jsa {
 
@@ -37,20 +37,22 @@ struct FitOptions {
     // "lambda_cycle").
     weights.cycle = 0.1;
   }
-  AtlasOptions atlas;          // K, network sizes, alpha
-  LossWeights weights;         // the lambdas of Eq. 5 (mean convention)
-  Components components;       // ablation switches (default: full method, row 11)
-  int64_t iterations = 5000;   // Adam steps
-  Index points = 2500;         // M: points sampled on P and on the shape per step
-  double lr = 1e-3;            // Adam learning rate
+  AtlasOptions atlas;                          // K, network sizes, alpha
+  LossWeights weights;                         // the lambdas of Eq. 5 (mean convention)
+  Components components;                       // ablation switches (default: full method, row 11)
+  int64_t iterations = 5000;                   // Adam steps
+  Index points = 2500;                         // M: points sampled on P and on the shape per step
+  double lr = 1e-3;                            // Adam learning rate
   std::vector<double> decay_at = {0.75, 0.9};  // fractions of `iterations` where lr *= decay
-  double decay = 0.1;          // step-decay factor
-  uint64_t seed = 1;           // every random draw derives from it
-  double repulsion_tolerance = 1e-7;  // cut-off error bound of L_rep
-  int max_faults = 5;          // NaN/Inf recoveries without getting past the failing iteration before giving up
-  double fault_lr_factor = 0.5;  // each NaN/Inf recovery multiplies the learning rate by this for the rest of the run
-  Index pool = 200000;         // surface samples drawn once per shape (the targets' pool)
-  int threads = 0;             // threads of the run (0: all); results depend on seed and threads
+  double decay = 0.1;                          // step-decay factor
+  uint64_t seed = 1;                           // every random draw derives from it
+  double repulsion_tolerance = 1e-7;           // cut-off error bound of L_rep
+  int max_faults =
+      5;  // NaN/Inf recoveries without getting past the failing iteration before giving up
+  double fault_lr_factor =
+      0.5;  // each NaN/Inf recovery multiplies the learning rate by this for the rest of the run
+  Index pool = 200000;  // surface samples drawn once per shape (the targets' pool)
+  int threads = 0;      // threads of the run (0: all); results depend on seed and threads
   // Every this many iterations before the first decay point, choose the global
   // orientation of phi (model/heuristics/orientation.h); 0: never. Only with normals in the loss.
   int orient_every = 100;
@@ -105,8 +107,10 @@ inline FitOptions paper_fit_options() {
 // A NaN or Inf caught in one step, and what the trainer did about it.
 struct FaultRecovery {
   int64_t iteration = 0;  // the iteration the failed step started from
-  int64_t restored = 0;   // the iteration of the restored state; steps restored..iteration are redone
-  double lr_scale = 1;    // the learning-rate scale from now on (FitOptions::fault_lr_factor per fault)
+  int64_t restored =
+      0;  // the iteration of the restored state; steps restored..iteration are redone
+  double lr_scale =
+      1;  // the learning-rate scale from now on (FitOptions::fault_lr_factor per fault)
 };
 // One line for logs and reports: what happened and what was done.
 std::string describe(const FaultRecovery& f);
@@ -117,7 +121,8 @@ struct StepReport {
   int64_t iterations = 0;  // the run's length
   double lr = 0;           // the learning rate the step used (schedule x fault scale)
   LossTerms terms;         // the step's loss terms (total NaN or Inf on a fault)
-  const FaultRecovery* fault = nullptr;  // set when the step failed and was undone (valid during the callback)
+  const FaultRecovery* fault =
+      nullptr;             // set when the step failed and was undone (valid during the callback)
   int faults = 0;          // faults so far in the run
   bool mirrored = false;   // the step mirrored the domain (model/heuristics/orientation.h)
   int mirrors = 0;         // mirrors so far
@@ -172,8 +177,12 @@ class Trainer {
   WrapReport wrap(const std::function<bool()>& cancelled = {});
   double learning_rate() const;  // the schedule at the current iteration, times the fault scale
   int faults() const { return int(fault_log_.size()); }
-  const std::vector<FaultRecovery>& fault_log() const { return fault_log_; }  // every recovery, in order
-  int mirrors() const { return mirrors_; }  // times the domain was mirrored (model/heuristics/orientation.h)
+  const std::vector<FaultRecovery>& fault_log() const {
+    return fault_log_;
+  }  // every recovery, in order
+  int mirrors() const {
+    return mirrors_;
+  }  // times the domain was mirrored (model/heuristics/orientation.h)
   int reseeded() const { return reseeded_; }  // Gaussians moved so far (model/heuristics/reseed.h)
   // Test hook: the next `count` attempts at `iteration` see a NaN loss.
   void inject_faults(int64_t iteration, int count) {
@@ -199,7 +208,7 @@ class Trainer {
 
  private:
   FitOptions options_;
-  std::vector<Block<float>> pools_;  // per shape P x 6, normals scaled by alpha
+  std::vector<Block<float>> pools_;            // per shape P x 6, normals scaled by alpha
   std::vector<NearestIndex<float>> surfaces_;  // per shape, over its pool (dense L_6D only)
   std::unique_ptr<Atlas<float>> atlas_;
   Adam<float> adam_;
@@ -218,8 +227,8 @@ class Trainer {
   } good_;
   double lr_scale_ = 1.0;
   std::vector<FaultRecovery> fault_log_;
-  int unresolved_faults_ = 0;       // recoveries since the run last got past a failing iteration
-  int64_t failed_iteration_ = -1;   // the furthest iteration that failed
+  int unresolved_faults_ = 0;      // recoveries since the run last got past a failing iteration
+  int64_t failed_iteration_ = -1;  // the furthest iteration that failed
   int64_t fault_at_ = -1;
   int faults_to_inject_ = 0;
   int mirrors_ = 0;

@@ -29,7 +29,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       return;
     o.threads = 1;
     jsa::Block<double> pool = jsa::Block<double>::Zero(16, 6);
-    for (jsa::Index i = 0; i < pool.rows(); ++i) pool.row(i) << double(i), double(i % 3), 1, 0, 0, 1;
+    for (jsa::Index i = 0; i < pool.rows(); ++i)
+      pool.row(i) << double(i), double(i % 3), 1, 0, 0, 1;
     jsa::Trainer trainer(o, std::vector<jsa::Block<double>>(contents.inputs.size(), pool));
     jsa::restore_trainer(trainer, contents, path);
   });
