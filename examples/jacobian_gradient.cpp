@@ -6,6 +6,7 @@
 // has an exact gradient in the weights from one backward(). The oracle shares no
 // code with the tape: L evaluated point by point with Dual<double, 2>
 // (engine/dual.h), differentiated in every weight by central differences.
+// The output bias b3 shifts phi but not J: its gradient is exactly zero.
 // Engine only. Exits non-zero if any weight's gradient disagrees.
 #include <algorithm>
 #include <cmath>
