@@ -67,9 +67,8 @@ int main() try {
   atlas.initialize(rng);
   Block<double> targets(32, 6);  // M points on the unit sphere: a point is its own normal
   for (Index i = 0; i < targets.rows(); ++i) {
-    Eigen::RowVector3d x(rng.normal(), rng.normal(), rng.normal());
-    x.normalize();
-    targets.row(i) << x, o.alpha * x;
+    const double x = rng.normal(), y = rng.normal(), z = rng.normal(), r = std::sqrt(x * x + y * y + z * z);
+    targets.row(i) << x / r, y / r, z / r, o.alpha * x / r, o.alpha * y / r, o.alpha * z / r;
   }
   const Rng draws(7);  // the step's random draws, reused below
   Tape<double> t;
