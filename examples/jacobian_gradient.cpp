@@ -27,10 +27,11 @@ Var loss_on_tape(Tape<double>& t, Var x, const std::vector<Var>& w) {
   Var h = stack_tangents(t, x);  // [x; e_u; e_v], 3N x 2
   for (int l = 0; l < 3; ++l) {
     h = linear(t, h, w[2 * l], w[2 * l + 1], /*bias_rows=*/n);  // bias on the value rows only
-    if (l < 2) h = softplus_stacked(t, h, n, kBeta);           // tangents times sigmoid(beta z)
+    if (l < 2) h = softplus_stacked(t, h, n, kBeta);            // tangents times sigmoid(beta z)
   }
   const Stacked j = unstack(t, h);  // f, J_u, J_v: N x 3 each
-  const Var e = offset(t, row_dot(t, j.du, j.du), -1.0), g = offset(t, row_dot(t, j.dv, j.dv), -1.0);
+  const Var e = offset(t, row_dot(t, j.du, j.du), -1.0),
+            g = offset(t, row_dot(t, j.dv, j.dv), -1.0);
   const Var f = row_dot(t, j.du, j.dv);
   const Var iso = mean(t, add(t, add(t, square(t, e), square(t, g)), scale(t, square(t, f), 2.0)));
   const Var n_z = slice_cols(t, row_normalize(t, cross3(t, j.du, j.dv)), 2, 1);
@@ -78,7 +79,8 @@ int main() {
   for (const Block<double>& b : w) wv.push_back(t.variable(b));
   const Var l = loss_on_tape(t, t.constant(x), wv);
   t.backward(l);
-  std::printf("L = %.6f (tape), %.6f (duals); %d tape nodes\n", t.scalar(l), loss_with_duals(x, w), t.size());
+  std::printf("L = %.6f (tape), %.6f (duals); %d tape nodes\n", t.scalar(l), loss_with_duals(x, w),
+              t.size());
 
   // Central differences through the dual forward, every weight. Error budget:
   // truncation ~h^2 f''' ~ 1e-11, round-off ~1e-16 / h ~ 1e-10.
@@ -95,7 +97,9 @@ int main() {
       w[b].data()[k] = keep;
       const double fd = (up - down) / (2 * h), tape = t.grad(wv[b]).data()[k];
       worst = std::max(worst, std::abs(tape - fd) / (1e-6 + std::abs(fd)));
-      if (k == 0) std::printf("  dL/d%s%d[0]: tape % .8f  central difference % .8f\n", b % 2 ? "b" : "W", int(b / 2) + 1, tape, fd);
+      if (k == 0)
+        std::printf("  dL/d%s%d[0]: tape % .8f  central difference % .8f\n", b % 2 ? "b" : "W",
+                    int(b / 2) + 1, tape, fd);
     }
   std::printf("%d weights, worst |tape - fd| / (1e-6 + |fd|) = %.2e\n", checked, worst);
   const bool ok = worst < 1e-5;

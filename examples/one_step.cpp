@@ -22,7 +22,8 @@ using namespace jsa;
 // L_single (Eq. 5) on the tape, with the library's default weights (the
 // paper's, as means; `jsatlas fit` lowers lambda_cycle to 0.1). rng is a copy:
 // calling twice with the same rng gives the same draws.
-Var step_loss(Tape<double>& t, Atlas<double>& a, const Block<double>& targets, Rng rng, bool print) {
+Var step_loss(Tape<double>& t, Atlas<double>& a, const Block<double>& targets, Rng rng,
+              bool print) {
   Parameters<double>& p = a.params;
   const Index m = targets.rows();
   auto show = [&](const char* what, Var v) {
@@ -36,26 +37,29 @@ Var step_loss(Tape<double>& t, Atlas<double>& a, const Block<double>& targets, R
   const Var out = a.phi.mlp().forward(t, p, in, /*value_rows=*/2 * m);
   const Stacked y = unstack(t, out);
   const Var n = scale(t, row_normalize(t, cross3(t, y.du, y.dv)), a.phi.alpha());  // Eq. 2
-  const Var phi6 = concat_cols(t, {y.value, n});                                      // Eq. 3
+  const Var phi6 = concat_cols(t, {y.value, n});                                   // Eq. 3
   const Var phi6_p = slice_rows(t, phi6, 0, m), phi6_s = slice_rows(t, phi6, m, m);
-  const std::pair<const char*, Var> blocks[] = {
-      {"x_P ~ P (Eq. 4)", x_p}, {"targets [x_S, alpha n_S]", s6}, {"u_S = psi(targets)", u_s},
-      {"[x; e_u; e_v], x = [x_P; u_S]", in}, {"[phi; J_u; J_v] = MLP(stacked rows)", out},
-      {"phi6 = [phi, n]", phi6}};
+  const std::pair<const char*, Var> blocks[] = {{"x_P ~ P (Eq. 4)", x_p},
+                                                {"targets [x_S, alpha n_S]", s6},
+                                                {"u_S = psi(targets)", u_s},
+                                                {"[x; e_u; e_v], x = [x_P; u_S]", in},
+                                                {"[phi; J_u; J_v] = MLP(stacked rows)", out},
+                                                {"phi6 = [phi, n]", phi6}};
   for (const auto& [what, v] : blocks) show(what, v);
   const LossWeights w;
   const double lambda[] = {w.surface, w.chart, w.cycle, w.cycle, w.isometry, w.repulsion};
   const Var terms[] = {
-      chamfer(t, phi6_p, s6),                                                      // L_6D  (Eq. 7)
-      chamfer(t, u_s, x_p),                                                        // L_2D  (Eq. 8)
-      mean_squared_distance(t, x_p, a.psi.evaluate(t, p, phi6_p)),                 // L_cycle 2D (Eq. 9)
-      mean_squared_distance(t, s6, phi6_s),                                        // L_cycle 6D (Eq. 9)
-      isometry_loss(t, slice_rows(t, y.du, 0, m), slice_rows(t, y.dv, 0, m)),      // L_iso (Eq. 10)
-      repulsion(t, p.on(t, a.domain.means()), a.domain.sigma())};                  // L_rep (Eq. 11)
+      chamfer(t, phi6_p, s6),                                                  // L_6D  (Eq. 7)
+      chamfer(t, u_s, x_p),                                                    // L_2D  (Eq. 8)
+      mean_squared_distance(t, x_p, a.psi.evaluate(t, p, phi6_p)),             // L_cycle 2D (Eq. 9)
+      mean_squared_distance(t, s6, phi6_s),                                    // L_cycle 6D (Eq. 9)
+      isometry_loss(t, slice_rows(t, y.du, 0, m), slice_rows(t, y.dv, 0, m)),  // L_iso (Eq. 10)
+      repulsion(t, p.on(t, a.domain.means()), a.domain.sigma())};              // L_rep (Eq. 11)
   const char* names[] = {"L_6D", "L_2D", "L_cycle 2D", "L_cycle 6D", "L_iso", "L_rep"};
   Var total = scale(t, terms[0], lambda[0]);
   for (int k = 1; k < 6; ++k) total = add(t, total, scale(t, terms[k], lambda[k]));
-  for (int k = 0; print && k < 6; ++k) std::printf("  %-10s %.6f  x lambda %g\n", names[k], t.scalar(terms[k]), lambda[k]);
+  for (int k = 0; print && k < 6; ++k)
+    std::printf("  %-10s %.6f  x lambda %g\n", names[k], t.scalar(terms[k]), lambda[k]);
   return total;
 }
 
@@ -67,7 +71,8 @@ int main() try {
   atlas.initialize(rng);
   Block<double> targets(32, 6);  // M points on the unit sphere: a point is its own normal
   for (Index i = 0; i < targets.rows(); ++i) {
-    const double x = rng.normal(), y = rng.normal(), z = rng.normal(), r = std::sqrt(x * x + y * y + z * z);
+    const double x = rng.normal(), y = rng.normal(), z = rng.normal(),
+                 r = std::sqrt(x * x + y * y + z * z);
     targets.row(i) << x / r, y / r, z / r, o.alpha * x / r, o.alpha * y / r, o.alpha * z / r;
   }
   const Rng draws(7);  // the step's random draws, reused below
@@ -78,7 +83,8 @@ int main() try {
 
   Tape<double> lib;  // (1) the library's objective on the same draws
   Rng same = draws;
-  const double library = lib.scalar(single_shape_objective(lib, atlas, 0, targets, 32, same, {}, nullptr));
+  const double library =
+      lib.scalar(single_shape_objective(lib, atlas, 0, targets, 32, same, {}, nullptr));
   atlas.params.zero_grad();
   t.backward(loss);  // every gradient lands in params.grads(), one flat buffer
   double g2 = 0;

@@ -58,7 +58,8 @@ TEST_CASE("dual softplus: value log(1 + e^(beta a)) / beta, derivative sigmoid(b
     }
   }
   // The stable form: e^(40 * 800) overflows a double, the rule does not.
-  const D big = softplus(D::variable(800.0, 0), 40.0), small = softplus(D::variable(-800.0, 0), 40.0);
+  const D big = softplus(D::variable(800.0, 0), 40.0),
+          small = softplus(D::variable(-800.0, 0), 40.0);
   CHECK(big.a == 800.0);
   CHECK(big.v[0] == 1.0);
   CHECK(small.a == 0.0);

@@ -233,7 +233,8 @@ TEST_CASE("softplus stacked-tangent Jacobian equals Dual<double,2>", "[tangents]
       const std::vector<D> f = mlp_dual(w, x(i, 0), x(i, 1), &min_preact, beta);
       for (Index c = 0; c < 3; ++c) {
         worst = std::max({worst, std::abs(t.value(s.value)(i, c) - f[c].a),
-                          std::abs(t.value(s.du)(i, c) - f[c].v[0]), std::abs(t.value(s.dv)(i, c) - f[c].v[1])});
+                          std::abs(t.value(s.du)(i, c) - f[c].v[0]),
+                          std::abs(t.value(s.dv)(i, c) - f[c].v[1])});
         largest = std::max({largest, std::abs(f[c].v[0]), std::abs(f[c].v[1])});
       }
     }

@@ -1,9 +1,10 @@
 // Tests of the three exercises (exercises.h), tagged [exercise]. Each fails on
 // the blank version and passes once the piece is right; the oracles are the
 // engine's own gradient checker (central differences) and Dual<double, 2>.
-#include <catch2/catch.hpp>
+#include "examples/exercises/exercises.h"
 
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <vector>
 
@@ -11,7 +12,6 @@
 #include "engine/ops.h"
 #include "engine/rng.h"
 #include "engine/tangents.h"
-#include "examples/exercises/exercises.h"
 
 namespace jsa::exercise {
 namespace {
@@ -33,14 +33,16 @@ TEST_CASE("exercise 1a: the dual rule of tanh", "[exercise]") {
   CHECK(f.v[1] == Approx(s1 * 0.7));
 }
 
-TEST_CASE("exercise 1b: tanh_stacked's value and tangent rows equal Dual<double, 2>", "[exercise]") {
+TEST_CASE("exercise 1b: tanh_stacked's value and tangent rows equal Dual<double, 2>",
+          "[exercise]") {
   // A 2-5-3 network tanh(x W1 + b1) W2 on stacked rows against the same with
   // duals (using your rule from 1a and the engine's linear).
   Rng rng(2);
-  const Block<double> x = random_block(rng, 4, 2), w1 = random_block(rng, 2, 5), b1 = random_block(rng, 1, 5),
-                      w2 = random_block(rng, 5, 3);
+  const Block<double> x = random_block(rng, 4, 2), w1 = random_block(rng, 2, 5),
+                      b1 = random_block(rng, 1, 5), w2 = random_block(rng, 5, 3);
   Tape<double> t;
-  const Var h = tanh_stacked(t, linear(t, stack_tangents(t, t.constant(x)), t.constant(w1), t.constant(b1), 4), 4);
+  const Var h = tanh_stacked(
+      t, linear(t, stack_tangents(t, t.constant(x)), t.constant(w1), t.constant(b1), 4), 4);
   const Block<double> y = t.value(linear(t, h, t.constant(w2), Var{}));
   double worst = 0;
   for (Index i = 0; i < 4; ++i) {
@@ -64,11 +66,14 @@ TEST_CASE("exercise 1b: tanh_stacked's value and tangent rows equal Dual<double,
 
 TEST_CASE("exercise 1b: tanh_stacked's pull-back passes the gradient check", "[exercise]") {
   Rng rng(3);
-  const GraphBuilder f = [](Tape<double>& t, const std::vector<Var>& in) { return tanh_stacked(t, in[0], 4); };
+  const GraphBuilder f = [](Tape<double>& t, const std::vector<Var>& in) {
+    return tanh_stacked(t, in[0], 4);
+  };
   const Block<double> x = random_block(rng, 12, 3);  // 3 blocks of 4 rows
   Tape<double> t;
   const Block<double> y = t.value(tanh_stacked(t, t.constant(x), 4));
-  CHECK((y.topRows(4).array() - x.topRows(4).array().tanh()).abs().maxCoeff() < 1e-15);  // the value rows
+  CHECK((y.topRows(4).array() - x.topRows(4).array().tanh()).abs().maxCoeff() <
+        1e-15);  // the value rows
   const GradCheckResult r = check_gradients(f, {x});
   INFO(r.report);
   CHECK(r.ok);
@@ -76,8 +81,11 @@ TEST_CASE("exercise 1b: tanh_stacked's pull-back passes the gradient check", "[e
 
 TEST_CASE("exercise 2: normalize_rows's pull-back passes the gradient check", "[exercise]") {
   Rng rng(4);
-  const GraphBuilder f = [](Tape<double>& t, const std::vector<Var>& in) { return normalize_rows(t, in[0]); };
-  const GradCheckResult r = check_gradients(f, {random_block(rng, 6, 3)});  // |x_i| well away from 0
+  const GraphBuilder f = [](Tape<double>& t, const std::vector<Var>& in) {
+    return normalize_rows(t, in[0]);
+  };
+  const GradCheckResult r =
+      check_gradients(f, {random_block(rng, 6, 3)});  // |x_i| well away from 0
   INFO(r.report);
   CHECK(r.ok);
 }
@@ -89,7 +97,8 @@ TEST_CASE("exercise 3: the hand-written gradient of L_iso equals the tape's", "[
   const double mine = isometry_grad(du, dv, d_du, d_dv);
   Tape<double> t;  // the same loss from the engine's ops (as losses/isometry.cpp)
   const Var u = t.variable(du), v = t.variable(dv);
-  const Var e = offset(t, row_dot(t, u, u), -1.0), g = offset(t, row_dot(t, v, v), -1.0), f = row_dot(t, u, v);
+  const Var e = offset(t, row_dot(t, u, u), -1.0), g = offset(t, row_dot(t, v, v), -1.0),
+            f = row_dot(t, u, v);
   const Var l = mean(t, add(t, add(t, square(t, e), square(t, g)), scale(t, square(t, f), 2.0)));
   t.backward(l);
   CHECK(mine == Approx(t.scalar(l)));

@@ -14,7 +14,8 @@ Var normalize_rows(Tape<double>& t, Var x) {
   Var y = t.node(t.rows(x), t.cols(x), {x});
   const Block<double>& X = t.value(x);
   Block<double>& Y = t.value(y);
-  for (Index i = 0; i < X.rows(); ++i) Y.row(i) = X.row(i) / std::sqrt(X.row(i).squaredNorm() + eps);
+  for (Index i = 0; i < X.rows(); ++i)
+    Y.row(i) = X.row(i) / std::sqrt(X.row(i).squaredNorm() + eps);
   t.on_backward(y, [x, eps](Tape<double>& t, Var y) {
     // TODO(exercise 2): add d(loss)/dx_i into t.grad(x).row(i), from
     // t.grad(y).row(i), t.value(y).row(i) and r_i.

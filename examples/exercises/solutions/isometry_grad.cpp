@@ -13,7 +13,8 @@ double isometry_grad(const Block<double>& du, const Block<double>& dv, Block<dou
   d_dv.setZero(n, 3);
   double loss = 0;
   for (Index i = 0; i < n; ++i) {
-    const double e = du.row(i).dot(du.row(i)), f = du.row(i).dot(dv.row(i)), g = dv.row(i).dot(dv.row(i));
+    const double e = du.row(i).dot(du.row(i)), f = du.row(i).dot(dv.row(i)),
+                 g = dv.row(i).dot(dv.row(i));
     loss += (e - 1) * (e - 1) + 2 * f * f + (g - 1) * (g - 1);
     d_du.row(i) = (4 * (e - 1) * du.row(i) + 4 * f * dv.row(i)) / double(n);
     d_dv.row(i) = (4 * f * du.row(i) + 4 * (g - 1) * dv.row(i)) / double(n);
