@@ -76,4 +76,20 @@ Dual<T, N> relu(const Dual<T, N>& x) {
   return x.a > T(0) ? x : Dual<T, N>(T(0));
 }
 
+// softplus_beta(a + u ε) = softplus_beta(a) + sigmoid(beta a) u ε,
+//   softplus_beta(z) = log(1 + e^(beta z)) / beta,  d/dz = sigmoid(beta z).
+// The default activation of phi and psi (engine/ops_linear.cpp, softplus_stacked);
+// written with e = e^(-|beta a|) <= 1 so that neither term overflows.
+template <class T, int N>
+Dual<T, N> softplus(const Dual<T, N>& x, T beta) {
+  using std::exp;
+  using std::log1p;
+  const T bz = beta * x.a;
+  const T e = exp(-(bz < T(0) ? -bz : bz));
+  const T sigmoid = bz >= T(0) ? T(1) / (T(1) + e) : e / (T(1) + e);
+  Dual<T, N> r(((bz > T(0) ? bz : T(0)) + log1p(e)) / beta);
+  for (int k = 0; k < N; ++k) r.v[k] = sigmoid * x.v[k];
+  return r;
+}
+
 }  // namespace jsa

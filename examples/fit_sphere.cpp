@@ -1,8 +1,12 @@
 // Example: fit an atlas of the unit sphere with the Trainer (model/tool/trainer.h).
-// FitOptions holds every setting, each with a documented default; here they are
-// made small (K = 256 Gaussians, 3 x 32 MLPs, M = 256 points) so the fit takes a few
-// seconds. The library never prints: the loop below reports progress itself.
-// Exits non-zero if L_6D (Eq. 7) does not drop tenfold.
+// FitOptions holds every setting, each with a documented default; here the sizes
+// are made small (K = 256 Gaussians, 3 x 32 MLPs, M = 256 points) so the fit takes
+// a few seconds. Everything else is inherited from FitOptions, i.e. `jsatlas fit`'s
+// defaults, not the paper's (docs/method.md, "Defaults"): alpha = 0.08, softplus
+// beta = 40, lambda_cycle = 0.1 (the other lambdas the paper's), the dense L_6D
+// over the whole pool, the orientation check every 100 steps, lr x 0.1 at 75% and
+// 90% of the iterations. The library never prints: the loop below reports
+// progress itself. Exits non-zero if L_6D (Eq. 7) does not drop tenfold.
 #include <cmath>
 #include <cstdio>
 #include <exception>

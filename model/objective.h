@@ -6,8 +6,9 @@
 // Convention: every term is a MEAN over its points (as Eqs. 6-10 write them),
 // so the paper's weights are l_6D = 1, l_2D = 1e-2, l_cycle = 1, l_iso = 1e-4,
 // l_rep = 1 (LossWeights' defaults; `jsatlas fit` lowers l_cycle, model/tool/trainer.h).
-// The paper's l_cycle = 1/M and l_iso = 1e-4/M are the same weights for losses
-// written as sums over the M points (the authors' code); see docs/method.md.
+// This reads the paper's l_cycle = 1/M and l_iso = 1e-4/M as weights of losses
+// written as sums over the M points: an inference from the text, one of three
+// readings compared in docs/method.md (D1).
 #pragma once
 #include "io/geometry/nearest.h"
 #include "model/atlas.h"

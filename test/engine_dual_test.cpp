@@ -45,4 +45,25 @@ TEST_CASE("dual relu passes or blocks the derivative", "[dual]") {
   CHECK(relu(n).v[1] == 0);
 }
 
+TEST_CASE("dual softplus: value log(1 + e^(beta a)) / beta, derivative sigmoid(beta a)", "[dual]") {
+  for (const double beta : {0.5, 2.0, 40.0}) {
+    for (const double a : {-1.3, -0.02, 0.0, 0.4, 2.0}) {
+      // f = softplus(u v) at (u, v) = (a, 1): f_u = sigmoid(beta a) v,  f_v = sigmoid(beta a) u
+      const D u = D::variable(a, 0), v = D::variable(1.0, 1);
+      const D f = softplus(u * v, beta);
+      const double sigmoid = 1.0 / (1.0 + std::exp(-beta * a));
+      CHECK(f.a == Approx(std::log1p(std::exp(beta * a)) / beta));
+      CHECK(f.v[0] == Approx(sigmoid));
+      CHECK(f.v[1] == Approx(sigmoid * a).margin(1e-15));
+    }
+  }
+  // The stable form: e^(40 * 800) overflows a double, the rule does not.
+  const D big = softplus(D::variable(800.0, 0), 40.0),
+          small = softplus(D::variable(-800.0, 0), 40.0);
+  CHECK(big.a == 800.0);
+  CHECK(big.v[0] == 1.0);
+  CHECK(small.a == 0.0);
+  CHECK(small.v[0] == 0.0);
+}
+
 }  // namespace jsa

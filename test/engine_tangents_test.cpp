@@ -43,8 +43,10 @@ Stacked mlp_stacked(Tape<double>& t, Var x, const std::vector<Var>& p, double be
 // The same network evaluated with dual numbers, one point at a time, written
 // without the engine: the independent oracle. Also reports the smallest
 // |pre-activation| seen, so tests can assert they are away from ReLU kinks.
+// beta = 0: ReLU; beta > 0: softplus (engine/dual.h's softplus rule).
 using D = Dual<double, 2>;
-std::vector<D> mlp_dual(const std::vector<Block<double>>& p, double u, double v, double* min_preact) {
+std::vector<D> mlp_dual(const std::vector<Block<double>>& p, double u, double v, double* min_preact,
+                        double beta = 0) {
   std::vector<D> h = {D::variable(u, 0), D::variable(v, 1)};
   for (int l = 0; l < 3; ++l) {
     const Block<double>& w = p[2 * l];
@@ -55,7 +57,7 @@ std::vector<D> mlp_dual(const std::vector<Block<double>>& p, double u, double v,
       for (Index i = 0; i < w.rows(); ++i) z += h[i] * D(w(i, j));
       if (l < 2) {
         *min_preact = std::min(*min_preact, std::abs(z.a));
-        z = relu(z);
+        z = beta > 0 ? softplus(z, beta) : relu(z);
       }
       out[j] = z;
     }
@@ -211,6 +213,33 @@ TEST_CASE("softplus stacked tangents equal finite differences of the value", "[t
     }
     INFO("beta " << beta << ": max |tape - finite difference| " << worst << ", largest entry " << largest);
     CHECK(worst < 1e-6);
+    CHECK(largest > 0.1);
+  }
+}
+
+// The default activation's second oracle: the stacked-tangent softplus
+// Jacobian against Dual<double, 2> through engine/dual.h's softplus rule (the
+// test above is the first: finite differences of the value rows).
+TEST_CASE("softplus stacked-tangent Jacobian equals Dual<double,2>", "[tangents][dual]") {
+  const auto w = mlp_weights(11);
+  const Block<double> x = points(12);
+  for (double beta : {0.5, 2.0, 40.0}) {
+    Tape<double> t;
+    std::vector<Var> p;
+    for (const auto& b : w) p.push_back(t.constant(b));
+    const Stacked s = mlp_stacked(t, t.constant(x), p, beta);
+    double worst = 0, largest = 0, min_preact = 1e9;
+    for (Index i = 0; i < kPoints; ++i) {
+      const std::vector<D> f = mlp_dual(w, x(i, 0), x(i, 1), &min_preact, beta);
+      for (Index c = 0; c < 3; ++c) {
+        worst = std::max({worst, std::abs(t.value(s.value)(i, c) - f[c].a),
+                          std::abs(t.value(s.du)(i, c) - f[c].v[0]),
+                          std::abs(t.value(s.dv)(i, c) - f[c].v[1])});
+        largest = std::max({largest, std::abs(f[c].v[0]), std::abs(f[c].v[1])});
+      }
+    }
+    INFO("beta " << beta << ": max |tape - dual| " << worst << ", largest entry " << largest);
+    CHECK(worst < 1e-12);  // the same arithmetic in another order: rounding only
     CHECK(largest > 0.1);
   }
 }
