@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   jsa::cli::add_correspond(app);
   jsa::cli::add_eval(app);
   jsa::cli::add_eval_corr(app);
+  jsa::cli::add_view(app);
   // CLI11 would call an unknown word "extra arguments"; name it instead.
   if (argc > 1 && argv[1][0] != '-') {
     bool known = false;
