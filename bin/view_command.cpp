@@ -6,9 +6,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "bin/commands.h"
 #include "engine/parallel.h"
@@ -81,8 +80,10 @@ void add_report(std::vector<ViewTableRow>& table, const std::string& group, cons
   if (j.is_discarded() || !j.is_object()) throw InputError(file.string() + ": not a JSON report");
   for (auto it = j.begin(); it != j.end(); ++it) {
     const nlohmann::json& v = it.value();
-    if (v.is_number()) table.push_back({group, it.key(), number(v.get<double>())});
-    else if (v.is_string() || v.is_boolean()) table.push_back({group, it.key(), v.is_string() ? v.get<std::string>() : v.dump()});
+    if (v.is_number())
+      table.push_back({group, it.key(), number(v.get<double>())});
+    else if (v.is_string() || v.is_boolean())
+      table.push_back({group, it.key(), v.is_string() ? v.get<std::string>() : v.dump()});
   }
 }
 
@@ -93,7 +94,8 @@ ViewCurves curves_of(const LossLog& log) {
   for (const LossLog::Row& r : log.rows) {
     c.iterations.push_back(double(r.iteration));
     const LossTerms& t = r.terms;
-    const double v[] = {t.total, t.surface, t.chart, t.cycle_2d, t.cycle_6d, t.isometry, t.repulsion};
+    const double v[] = {t.total,    t.surface,  t.chart,    t.cycle_2d,
+                        t.cycle_6d, t.isometry, t.repulsion};
     for (size_t k = 0; k < c.names.size(); ++k) c.values[k].push_back(v[k]);
   }
   return c;
@@ -114,17 +116,21 @@ void run_view(const ViewArgs& a) {
   for (const std::string& input : contents.inputs) meshes.push_back(load_shape(input));
   std::vector<std::vector<int>> keypoints(n);
   if (!a.keypoints.empty()) {
-    if (!collection) throw InputError("view: --keypoints needs a collection (the run has one shape)");
+    if (!collection)
+      throw InputError("view: --keypoints needs a collection (the run has one shape)");
     for (size_t i = 0; i < n; ++i) {
-      const fs::path f = fs::path(a.keypoints) / (fs::path(contents.inputs[i]).stem().string() + ".vts");
-      if (!fs::exists(f)) throw InputError("view: no keypoint file " + f.string() + " for " + contents.inputs[i]);
+      const fs::path f =
+          fs::path(a.keypoints) / (fs::path(contents.inputs[i]).stem().string() + ".vts");
+      if (!fs::exists(f))
+        throw InputError("view: no keypoint file " + f.string() + " for " + contents.inputs[i]);
       keypoints[i] = read_keypoints(f.string(), long(meshes[i].vertices.rows()));
     }
   }
 
   const TextureFrame frame = texture_frame(*atlas);
   const DomainMesh dm = mesh_domain(*atlas, DomainMeshOptions{a.resolution, a.threshold});
-  if (dm.faces.rows() == 0) throw InputError("view: no domain above --mesh-threshold " + std::to_string(a.threshold));
+  if (dm.faces.rows() == 0)
+    throw InputError("view: no domain above --mesh-threshold " + std::to_string(a.threshold));
   CorrespondenceOptions co;
   co.use_chart = options.components.chart;
 
@@ -153,12 +159,14 @@ void run_view(const ViewArgs& a) {
       for (size_t j = 0; j < n; ++j) {
         if (j == i) continue;
         const Normalization& fj = contents.normalizations[j];
-        const Block<double> q = fj.from_unit(correspond(*atlas, int(i), int(j), s.vertices, vertex_normals, co));
+        const Block<double> q =
+            fj.from_unit(correspond(*atlas, int(i), int(j), s.vertices, vertex_normals, co));
         nearest(q, meshes[j].vertices, s.correspondence[j]);
         // Keypoint m: the error of the paper's metric, |q - keypoint m of j| in j's unit frame.
         for (size_t k = 0; k < keypoints[i].size(); ++k) {
           const Eigen::RowVector3d qu = (q.row(keypoints[i][k]) - fj.center) / fj.scale;
-          const Eigen::RowVector3d gt = (meshes[j].vertices.row(keypoints[j][k]) - fj.center) / fj.scale;
+          const Eigen::RowVector3d gt =
+              (meshes[j].vertices.row(keypoints[j][k]) - fj.center) / fj.scale;
           s.keypoint_error[j].push_back((qu - gt).norm());
         }
       }
@@ -172,26 +180,34 @@ void run_view(const ViewArgs& a) {
   const std::string shape0_dir = collection ? a.run + "/shape_0" : a.run;
   const std::string texture = run_texture_path(shape0_dir);
   page.texture = shrink(texture.empty() ? colour_chart(512) : read_image(texture), 512);
-  page.table.push_back({"run", "texture", texture.empty() ? "built-in colour chart" : fs::path(texture).filename().string()});
+  page.table.push_back(
+      {"run", "texture",
+       texture.empty() ? "built-in colour chart" : fs::path(texture).filename().string()});
   page.table.push_back({"run", "shapes", std::to_string(n)});
   page.table.push_back({"run", "iterations", std::to_string(options.iterations)});
-  page.table.push_back({"run", "gaussians K", std::to_string(atlas->params.value(atlas->domain.means()).rows())});
+  page.table.push_back(
+      {"run", "gaussians K", std::to_string(atlas->params.value(atlas->domain.means()).rows())});
   page.curves = curves_of(read_loss_log(a.run + "/losses.csv", options.iterations));
 
   if (collection) {
     for (size_t i = 0; i < n; ++i) {
       const fs::path dir = fs::path(a.run) / ("shape_" + std::to_string(i));
-      add_report(page.table, "eval_" + std::to_string(i) + ".json", fs::path(a.run) / ("eval_" + std::to_string(i) + ".json"));
-      add_report(page.table, "shape_" + std::to_string(i) + "/input_chart_uv.json", dir / "input_chart_uv.json");
-      add_report(page.table, "shape_" + std::to_string(i) + "/domain_mesh_uv.json", dir / "domain_mesh_uv.json");
+      add_report(page.table, "eval_" + std::to_string(i) + ".json",
+                 fs::path(a.run) / ("eval_" + std::to_string(i) + ".json"));
+      add_report(page.table, "shape_" + std::to_string(i) + "/input_chart_uv.json",
+                 dir / "input_chart_uv.json");
+      add_report(page.table, "shape_" + std::to_string(i) + "/domain_mesh_uv.json",
+                 dir / "domain_mesh_uv.json");
     }
     add_report(page.table, "eval_corr.json", fs::path(a.run) / "eval_corr.json");
     if (!a.keypoints.empty()) {
-      const KeypointError e = keypoint_error(*atlas, meshes, contents.normalizations, keypoints, co);
+      const KeypointError e =
+          keypoint_error(*atlas, meshes, contents.normalizations, keypoints, co);
       const std::string g = "keypoints (" + a.keypoints + ")";
       page.table.push_back({g, "mean L2 x1e-2, unit frame", number(100 * e.mean)});
       for (size_t t = 0; t < e.thresholds.size(); ++t)
-        page.table.push_back({g, "within " + number(e.thresholds[t]), number(100 * e.within[t]) + "%"});
+        page.table.push_back(
+            {g, "within " + number(e.thresholds[t]), number(100 * e.within[t]) + "%"});
     }
   } else {
     add_report(page.table, "eval.json", fs::path(a.run) / "eval.json");
@@ -200,31 +216,37 @@ void run_view(const ViewArgs& a) {
   }
 
   const std::string html = view_page_html(page, three);
-  write_file_atomically(out, [&](std::ostream& f) { f.write(html.data(), std::streamsize(html.size())); });
-  std::printf("written: %s (%.2f MB; %zu shape%s)\n", out.c_str(), double(html.size()) / (1 << 20), n,
-              n == 1 ? "" : "s");
+  write_file_atomically(
+      out, [&](std::ostream& f) { f.write(html.data(), std::streamsize(html.size())); });
+  std::printf("written: %s (%.2f MB; %zu shape%s)\n", out.c_str(), double(html.size()) / (1 << 20),
+              n, n == 1 ? "" : "s");
 }
 
 }  // namespace
 
 void add_view(CLI::App& app) {
   auto a = std::make_shared<ViewArgs>();
-  CLI::App* c = app.add_subcommand(
-      "view", "Write one self-contained HTML page showing a run: shapes, UVs, domain, correspondences, losses");
+  CLI::App* c = app.add_subcommand("view",
+                                   "Write one self-contained HTML page showing a run: shapes, UVs, "
+                                   "domain, correspondences, losses");
   c->add_option("run", a->run, "Run directory (holds model.ckpt)")->required();
   c->add_option("-o,--out", a->out, "Page to write (default: RUN/view.html)");
   c->add_option("--keypoints", a->keypoints,
-                "Collections: a directory holding <input stem>.vts per shape; the page shows each keypoint's error");
+                "Collections: a directory holding <input stem>.vts per shape; the page shows each "
+                "keypoint's error");
   c->add_option("--three-dir", a->three_dir,
                 "Where three.min.js and examples/js/controls/OrbitControls.js are (default: "
                 "/usr/share/javascript/three, Debian's libjs-three)");
-  c->add_option("--mesh-resolution", a->resolution, "Grid cells across the domain for the meshed domain")
+  c->add_option("--mesh-resolution", a->resolution,
+                "Grid cells across the domain for the meshed domain")
       ->capture_default_str()
       ->check(CLI::Range(8, 4096));
   c->add_option("--mesh-threshold", a->threshold, "Domain = {P >= t * median of P at the means}")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 100.0));
-  c->add_option("--threads", a->threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
+  c->add_option("--threads", a->threads, "Threads (0: all cores)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1024));
   c->callback([a]() { run_view(*a); });
 }
 

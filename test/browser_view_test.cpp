@@ -30,12 +30,13 @@ Result browser(const std::string& args, const std::string& dir) {
   const std::string profile = dir + "/chromium-profile";
   std::filesystem::remove_all(profile);
   std::filesystem::create_directories(profile);
-  const std::string cmd =
-      "timeout 180 " + chromium_path() +
-      " --headless --no-sandbox --disable-gpu --disable-quic --no-first-run --disable-background-networking"
-      " --disable-component-update --disable-sync --use-angle=swiftshader --enable-unsafe-swiftshader"
-      " --hide-scrollbars --user-data-dir=" +
-      profile + " " + args;
+  const std::string cmd = "timeout 180 " + chromium_path() +
+                          " --headless --no-sandbox --disable-gpu --disable-quic --no-first-run "
+                          "--disable-background-networking"
+                          " --disable-component-update --disable-sync --use-angle=swiftshader "
+                          "--enable-unsafe-swiftshader"
+                          " --hide-scrollbars --user-data-dir=" +
+                          profile + " " + args;
   Result r;
   FILE* p = popen((cmd + " 2>/dev/null").c_str(), "r");
   if (!p) return r;
@@ -48,8 +49,10 @@ Result browser(const std::string& args, const std::string& dir) {
 }
 
 // The page writes its state (errors, clicks, ...) as JSON into <pre id="jsatlas-state">.
-nlohmann::json page_state(const std::string& page, const std::string& hash, const std::string& dir) {
-  const Result r = browser("--virtual-time-budget=10000 --dump-dom 'file://" + page + hash + "'", dir);
+nlohmann::json page_state(const std::string& page, const std::string& hash,
+                          const std::string& dir) {
+  const Result r =
+      browser("--virtual-time-budget=10000 --dump-dom 'file://" + page + hash + "'", dir);
   INFO("chromium exit " << r.code);
   const std::string open = "<pre id=\"jsatlas-state\">";
   const size_t a = r.output.find(open), b = r.output.find("</pre>", a);
@@ -57,8 +60,10 @@ nlohmann::json page_state(const std::string& page, const std::string& hash, cons
   REQUIRE(b != std::string::npos);
   std::string text = r.output.substr(a + open.size(), b - a - open.size());
   // Text nodes are serialised with &, <, > escaped.
-  for (const auto& [entity, ch] : {std::pair<std::string, std::string>{"&lt;", "<"}, {"&gt;", ">"}, {"&amp;", "&"}})
-    for (size_t i = 0; (i = text.find(entity, i)) != std::string::npos;) text.replace(i, entity.size(), ch), i += ch.size();
+  for (const auto& [entity, ch] :
+       {std::pair<std::string, std::string>{"&lt;", "<"}, {"&gt;", ">"}, {"&amp;", "&"}})
+    for (size_t i = 0; (i = text.find(entity, i)) != std::string::npos;)
+      text.replace(i, entity.size(), ch), i += ch.size();
   REQUIRE(!text.empty());
   return nlohmann::json::parse(text);
 }
@@ -84,7 +89,8 @@ Pixels pixel_statistics(const jsa::Image& image) {
   return s;
 }
 
-const std::string kSmall = " -K 200 -M 200 --width 16 --depth 2 --threads 1 --pool 5000 --mesh-resolution 32 -q";
+const std::string kSmall =
+    " -K 200 -M 200 --width 16 --depth 2 --threads 1 --pool 5000 --mesh-resolution 32 -q";
 
 }  // namespace
 
@@ -98,7 +104,9 @@ TEST_CASE("view: a single-shape run's page draws the shape and logs no error") {
   const std::string page = dir + "/view.html";
 
   const std::string shot = dir + "/shot.png";
-  browser("--window-size=1280,800 --virtual-time-budget=10000 --screenshot=" + shot + " 'file://" + page + "'", dir);
+  browser("--window-size=1280,800 --virtual-time-budget=10000 --screenshot=" + shot + " 'file://" +
+              page + "'",
+          dir);
   REQUIRE(std::filesystem::exists(shot));
   const jsa::Image image = jsa::read_image(shot);
   REQUIRE(image.width == 1280);
@@ -122,15 +130,17 @@ TEST_CASE("view: a single-shape run's page draws the shape and logs no error") {
 
 TEST_CASE("view: a click on shape 0 marks on shape 1 the vertex jsatlas correspond gives") {
   const std::string dir = fresh_dir("view_collection");
-  REQUIRE(run("fit builtin:sphere builtin:torus -o " + dir + " --iters 10 --code-size 8" + kSmall).code == 0);
-  const Result v = run("view " + dir + " -o " + dir + "/page.html --mesh-resolution 32 --threads 1");
+  REQUIRE(run("fit builtin:sphere builtin:torus -o " + dir + " --iters 10 --code-size 8" + kSmall)
+              .code == 0);
+  const Result v =
+      run("view " + dir + " -o " + dir + "/page.html --mesh-resolution 32 --threads 1");
   INFO(v.output);
   REQUIRE(v.code == 0);
   const std::string page = dir + "/page.html";
   const long sphere_vertices = long(jsa::builtin_shape("sphere").vertices.rows());
   for (const long vertex : {123L, sphere_vertices - 1}) {
-    const Result c = run("correspond " + dir + " --from 0 --to 1 --vertices " + std::to_string(vertex) +
-                         " --snap --threads 1");
+    const Result c = run("correspond " + dir + " --from 0 --to 1 --vertices " +
+                         std::to_string(vertex) + " --snap --threads 1");
     INFO(c.output);
     REQUIRE(c.code == 0);
     // Last line: "x y z index"
@@ -152,7 +162,9 @@ TEST_CASE("view: a click on shape 0 marks on shape 1 the vertex jsatlas correspo
 
 int main(int argc, char** argv) {
   if (chromium_path().empty()) {
-    std::printf("SKIPPED: no chromium (Debian: apt-get install chromium) to load the page of jsatlas view\n");
+    std::printf(
+        "SKIPPED: no chromium (Debian: apt-get install chromium) to load the page of jsatlas "
+        "view\n");
     return 77;
   }
   return Catch::Session().run(argc, argv);

@@ -12,7 +12,8 @@ using namespace cli_test;
 
 namespace {
 
-const std::string kSmall = " -K 200 -M 200 --width 16 --depth 2 --threads 1 --pool 5000 --mesh-resolution 32 -q";
+const std::string kSmall =
+    " -K 200 -M 200 --width 16 --depth 2 --threads 1 --pool 5000 --mesh-resolution 32 -q";
 
 std::vector<std::uint8_t> unbase64(const std::string& s) {
   std::vector<std::uint8_t> out;
@@ -40,17 +41,19 @@ nlohmann::json page_data(const std::string& html) {
 long index_at(const nlohmann::json& packed, long k) {
   const std::vector<std::uint8_t> b = unbase64(packed["b64"].get<std::string>());
   if (packed["type"] == "u16") return long(b[size_t(2 * k)]) | long(b[size_t(2 * k + 1)]) << 8;
-  return long(b[size_t(4 * k)]) | long(b[size_t(4 * k + 1)]) << 8 | long(b[size_t(4 * k + 2)]) << 16 |
-         long(b[size_t(4 * k + 3)]) << 24;
+  return long(b[size_t(4 * k)]) | long(b[size_t(4 * k + 1)]) << 8 |
+         long(b[size_t(4 * k + 2)]) << 16 | long(b[size_t(4 * k + 3)]) << 24;
 }
 
 }  // namespace
 
 TEST_CASE("view: the page stands alone and carries the correspondences and keypoint errors") {
   const std::string dir = fresh_dir("cli_view");
-  REQUIRE(run("fit builtin:sphere builtin:torus -o " + dir + " --iters 6 --code-size 8" + kSmall).code == 0);
+  REQUIRE(run("fit builtin:sphere builtin:torus -o " + dir + " --iters 6 --code-size 8" + kSmall)
+              .code == 0);
   // Keypoints as SHREC gives them: <input stem>.vts, one vertex index per line.
-  const long nv[2] = {long(jsa::builtin_shape("sphere").vertices.rows()), long(jsa::builtin_shape("torus").vertices.rows())};
+  const long nv[2] = {long(jsa::builtin_shape("sphere").vertices.rows()),
+                      long(jsa::builtin_shape("torus").vertices.rows())};
   write_text(dir + "/builtin:sphere.vts", "3\n17\n" + std::to_string(nv[0] - 1) + "\n");
   write_text(dir + "/builtin:torus.vts", "8\n0\n" + std::to_string(nv[1] - 1) + "\n");
   const Result v = run("view " + dir + " --keypoints " + dir + " --mesh-resolution 32 --threads 1");
@@ -70,7 +73,8 @@ TEST_CASE("view: the page stands alone and carries the correspondences and keypo
   const nlohmann::json& to1 = d["shapes"][0]["correspondence"][1];
   REQUIRE(to1["n"] == nv[0]);
   for (const long vertex : {0L, 40L, nv[0] - 1}) {
-    const Result c = run("correspond " + dir + " --from 0 --to 1 --vertices " + std::to_string(vertex) + " --snap");
+    const Result c = run("correspond " + dir + " --from 0 --to 1 --vertices " +
+                         std::to_string(vertex) + " --snap");
     REQUIRE(c.code == 0);
     std::istringstream last(c.output.substr(c.output.rfind('\n', c.output.size() - 2) + 1));
     double x, y, z;

@@ -104,8 +104,8 @@ std::string encode_png(const Image& image) {
   auto append = [](void* out, void* data, int size) {
     static_cast<std::string*>(out)->append(static_cast<const char*>(data), std::size_t(size));
   };
-  const int ok = stbi_write_png_to_func(append, &bytes, image.width, image.height, 3, image.rgb.data(),
-                                        image.width * 3);
+  const int ok = stbi_write_png_to_func(append, &bytes, image.width, image.height, 3,
+                                        image.rgb.data(), image.width * 3);
   JSA_CHECK(ok != 0, "stb could not encode a " << image.width << " x " << image.height << " PNG");
   return bytes;
 }
@@ -113,7 +113,8 @@ std::string encode_png(const Image& image) {
 void write_png(const std::string& path, const Image& image) {
   JSA_CHECK(image.width > 0 && image.height > 0, "cannot write an empty image to " << path);
   const std::string bytes = encode_png(image);
-  write_file_atomically(path, [&](std::ostream& out) { out.write(bytes.data(), std::streamsize(bytes.size())); });
+  write_file_atomically(
+      path, [&](std::ostream& out) { out.write(bytes.data(), std::streamsize(bytes.size())); });
 }
 
 // ---- drawing ----

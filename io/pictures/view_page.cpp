@@ -3,9 +3,8 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "engine/check.h"
 
@@ -19,7 +18,8 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
-void put_u16(std::vector<std::uint8_t>& out, std::uint32_t v) {  // little-endian, as JS typed arrays read it
+void put_u16(std::vector<std::uint8_t>& out,
+             std::uint32_t v) {  // little-endian, as JS typed arrays read it
   out.push_back(std::uint8_t(v & 0xff));
   out.push_back(std::uint8_t(v >> 8));
 }
@@ -38,7 +38,8 @@ json quantised(const Block<double>& m) {
   for (Index k = 0; k < c && n > 0; ++k) {
     lo[size_t(k)] = m.col(k).minCoeff();
     hi[size_t(k)] = m.col(k).maxCoeff();
-    JSA_CHECK(std::isfinite(lo[size_t(k)]) && std::isfinite(hi[size_t(k)]), "non-finite values in a view array");
+    JSA_CHECK(std::isfinite(lo[size_t(k)]) && std::isfinite(hi[size_t(k)]),
+              "non-finite values in a view array");
   }
   std::vector<std::uint8_t> bytes;
   bytes.reserve(size_t(n * c * 2));
@@ -64,7 +65,9 @@ json indices(const std::vector<int>& v, Index limit) {
     JSA_CHECK(i >= 0 && i < limit, "index " << i << " outside 0.." << limit - 1);
     small ? put_u16(bytes, std::uint32_t(i)) : put_u32(bytes, std::uint32_t(i));
   }
-  return json{{"type", small ? "u16" : "u32"}, {"n", v.size()}, {"b64", base64(bytes.data(), bytes.size())}};
+  return json{{"type", small ? "u16" : "u32"},
+              {"n", v.size()},
+              {"b64", base64(bytes.data(), bytes.size())}};
 }
 
 json face_indices(const Faces& f, Index vertex_count) {
@@ -87,7 +90,8 @@ json shape_json(const ViewShape& s, size_t shape_count) {
   const Index V = s.vertices.rows();
   JSA_CHECK(V > 0 && s.vertices.cols() == 3, "shape " << s.name << ": no vertices");
   JSA_CHECK(s.uv.rows() == 0 || s.uv.rows() == V, "shape " << s.name << ": one uv per vertex");
-  JSA_CHECK(s.domain_uv.rows() == s.domain_vertices.rows(), "shape " << s.name << ": one domain uv per vertex");
+  JSA_CHECK(s.domain_uv.rows() == s.domain_vertices.rows(),
+            "shape " << s.name << ": one domain uv per vertex");
   json j;
   j["name"] = s.name;
   j["vertices"] = quantised(s.vertices);
@@ -111,7 +115,8 @@ json shape_json(const ViewShape& s, size_t shape_count) {
 
 // Replaces each `marker` of the template by its text, in one pass, so that no
 // inserted text (three.js, data) is searched for markers.
-std::string fill(const std::string& tpl, const std::vector<std::pair<std::string, std::string>>& parts) {
+std::string fill(const std::string& tpl,
+                 const std::vector<std::pair<std::string, std::string>>& parts) {
   std::string out;
   size_t at = 0;
   while (true) {
@@ -136,7 +141,8 @@ std::string script_safe(std::string s) {
   for (size_t i = 0; i + 8 <= s.size(); ++i) {
     if (s[i] != '<' || s[i + 1] != '/') continue;
     std::string word = s.substr(i + 2, 6);
-    std::transform(word.begin(), word.end(), word.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
+    std::transform(word.begin(), word.end(), word.begin(),
+                   [](unsigned char ch) { return char(std::tolower(ch)); });
     if (word == "script") s.insert(i + 1, "\\");
   }
   return s;
@@ -152,11 +158,13 @@ std::string read_text(const fs::path& p) {
 }  // namespace
 
 std::string base64(const std::uint8_t* data, std::size_t size) {
-  static const char* const table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  static const char* const table =
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
   out.reserve((size + 2) / 3 * 4);
   for (std::size_t i = 0; i < size; i += 3) {
-    const std::uint32_t a = data[i], b = i + 1 < size ? data[i + 1] : 0, c = i + 2 < size ? data[i + 2] : 0;
+    const std::uint32_t a = data[i], b = i + 1 < size ? data[i + 1] : 0,
+                        c = i + 2 < size ? data[i + 2] : 0;
     const std::uint32_t triple = (a << 16) | (b << 8) | c;
     out += table[(triple >> 18) & 63];
     out += table[(triple >> 12) & 63];
@@ -172,15 +180,20 @@ ThreeJs read_three_js(const std::string& dir) {
   // THREE.OrbitControls to the global THREE) under examples/js/controls/.
   const fs::path three = root / "three.min.js";
   const fs::path orbit = root / "examples/js/controls/OrbitControls.js";
-  const std::string hint = dir.empty() ? " (install the Debian package libjs-three, or give --three-dir)"
-                                       : " (--three-dir must hold three.min.js and examples/js/controls/OrbitControls.js)";
+  const std::string hint =
+      dir.empty()
+          ? " (install the Debian package libjs-three, or give --three-dir)"
+          : " (--three-dir must hold three.min.js and examples/js/controls/OrbitControls.js)";
   for (const fs::path& p : {three, orbit})
-    if (!fs::is_regular_file(p)) throw InputError("view: three.js not found: no " + p.string() + hint);
+    if (!fs::is_regular_file(p))
+      throw InputError("view: three.js not found: no " + p.string() + hint);
   ThreeJs t;
   t.three = read_text(three);
   t.orbit_controls = read_text(orbit);
-  if (t.three.find("WebGLRenderer") == std::string::npos || t.orbit_controls.find("OrbitControls") == std::string::npos)
-    throw InputError("view: " + root.string() + " does not hold three.js as libjs-three ships it" + hint);
+  if (t.three.find("WebGLRenderer") == std::string::npos ||
+      t.orbit_controls.find("OrbitControls") == std::string::npos)
+    throw InputError("view: " + root.string() + " does not hold three.js as libjs-three ships it" +
+                     hint);
   return t;
 }
 
@@ -193,7 +206,8 @@ std::string view_page_html(const ViewPage& page, const ThreeJs& three) {
   d["domain"] = {{"means", quantised(page.domain.means)}, {"sigma", page.domain.sigma}};
   if (page.texture.width > 0) {
     const std::string png = encode_png(page.texture);
-    d["texture"] = "data:image/png;base64," + base64(reinterpret_cast<const std::uint8_t*>(png.data()), png.size());
+    d["texture"] = "data:image/png;base64," +
+                   base64(reinterpret_cast<const std::uint8_t*>(png.data()), png.size());
   } else {
     d["texture"] = nullptr;
   }
@@ -217,10 +231,14 @@ std::string view_page_html(const ViewPage& page, const ThreeJs& three) {
   const std::string escaped_title = [&] {
     std::string t;
     for (const char ch : page.title) {
-      if (ch == '<') t += "&lt;";
-      else if (ch == '>') t += "&gt;";
-      else if (ch == '&') t += "&amp;";
-      else t += ch;
+      if (ch == '<')
+        t += "&lt;";
+      else if (ch == '>')
+        t += "&gt;";
+      else if (ch == '&')
+        t += "&amp;";
+      else
+        t += ch;
     }
     return t;
   }();

@@ -16,10 +16,10 @@
 namespace jsa {
 
 struct ViewShape {
-  std::string name;          // shown above the shape (e.g. the input's file name)
-  Block<double> vertices;    // V x 3, the input in its unit frame (every shape is shown in its own)
-  Faces faces;               // F x 3; 0 x 3 for a point cloud (then shown as points)
-  Block<double> uv;          // V x 2 texture-frame coordinates of psi at each vertex; 0 x 2 if no chart
+  std::string name;        // shown above the shape (e.g. the input's file name)
+  Block<double> vertices;  // V x 3, the input in its unit frame (every shape is shown in its own)
+  Faces faces;             // F x 3; 0 x 3 for a point cloud (then shown as points)
+  Block<double> uv;  // V x 2 texture-frame coordinates of psi at each vertex; 0 x 2 if no chart
   Block<double> domain_vertices;  // D x 3, phi of the meshed domain's vertices (unit frame)
   Faces domain_faces;             // the meshed domain's triangles (shared by every shape)
   Block<double> domain_uv;        // D x 2 texture-frame coordinates of those vertices
@@ -57,8 +57,8 @@ struct ViewPage {
 
 // three.js as Debian's libjs-three ships it (non-module builds).
 struct ThreeJs {
-  std::string three;            // three.min.js
-  std::string orbit_controls;   // OrbitControls.js, the form that attaches THREE.OrbitControls
+  std::string three;           // three.min.js
+  std::string orbit_controls;  // OrbitControls.js, the form that attaches THREE.OrbitControls
 };
 
 // Reads three.min.js and OrbitControls.js from `dir` (empty: /usr/share/javascript/three).
