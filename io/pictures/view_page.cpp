@@ -86,7 +86,9 @@ json float32(const std::vector<double>& v) {
   return json{{"n", v.size()}, {"b64", base64(bytes.data(), bytes.size())}};
 }
 
-json shape_json(const ViewShape& s, size_t shape_count) {
+// first: the page's shape 0, whose meshed domain (faces, uv) the others share
+// as a rule (one domain, one grid): then theirs is not written twice.
+json shape_json(const ViewShape& s, size_t shape_count, const ViewShape& first) {
   const Index V = s.vertices.rows();
   JSA_CHECK(V > 0 && s.vertices.cols() == 3, "shape " << s.name << ": no vertices");
   JSA_CHECK(s.uv.rows() == 0 || s.uv.rows() == V, "shape " << s.name << ": one uv per vertex");
@@ -98,8 +100,11 @@ json shape_json(const ViewShape& s, size_t shape_count) {
   j["faces"] = face_indices(s.faces, V);
   j["uv"] = s.uv.rows() > 0 ? quantised(s.uv) : json(nullptr);
   j["domain_vertices"] = quantised(s.domain_vertices);
-  j["domain_faces"] = face_indices(s.domain_faces, s.domain_vertices.rows());
-  j["domain_uv"] = quantised(s.domain_uv);
+  const bool shared = &s != &first && s.domain_faces.rows() == first.domain_faces.rows() &&
+                      s.domain_uv.rows() == first.domain_uv.rows() && s.domain_faces == first.domain_faces &&
+                      s.domain_uv == first.domain_uv;
+  j["domain_faces"] = shared ? json(nullptr) : face_indices(s.domain_faces, s.domain_vertices.rows());
+  j["domain_uv"] = shared ? json(nullptr) : quantised(s.domain_uv);
   json corr = json::array();
   for (size_t t = 0; t < shape_count; ++t) {
     const bool has = t < s.correspondence.size() && !s.correspondence[t].empty();
@@ -202,7 +207,7 @@ std::string view_page_html(const ViewPage& page, const ThreeJs& three) {
   json d;
   d["title"] = page.title;
   d["shapes"] = json::array();
-  for (const ViewShape& s : page.shapes) d["shapes"].push_back(shape_json(s, page.shapes.size()));
+  for (const ViewShape& s : page.shapes) d["shapes"].push_back(shape_json(s, page.shapes.size(), page.shapes[0]));
   d["domain"] = {{"means", quantised(page.domain.means)}, {"sigma", page.domain.sigma}};
   if (page.texture.width > 0) {
     const std::string png = encode_png(page.texture);
