@@ -101,9 +101,10 @@ json shape_json(const ViewShape& s, size_t shape_count, const ViewShape& first) 
   j["uv"] = s.uv.rows() > 0 ? quantised(s.uv) : json(nullptr);
   j["domain_vertices"] = quantised(s.domain_vertices);
   const bool shared = &s != &first && s.domain_faces.rows() == first.domain_faces.rows() &&
-                      s.domain_uv.rows() == first.domain_uv.rows() && s.domain_faces == first.domain_faces &&
-                      s.domain_uv == first.domain_uv;
-  j["domain_faces"] = shared ? json(nullptr) : face_indices(s.domain_faces, s.domain_vertices.rows());
+                      s.domain_uv.rows() == first.domain_uv.rows() &&
+                      s.domain_faces == first.domain_faces && s.domain_uv == first.domain_uv;
+  j["domain_faces"] =
+      shared ? json(nullptr) : face_indices(s.domain_faces, s.domain_vertices.rows());
   j["domain_uv"] = shared ? json(nullptr) : quantised(s.domain_uv);
   json corr = json::array();
   for (size_t t = 0; t < shape_count; ++t) {
@@ -207,7 +208,8 @@ std::string view_page_html(const ViewPage& page, const ThreeJs& three) {
   json d;
   d["title"] = page.title;
   d["shapes"] = json::array();
-  for (const ViewShape& s : page.shapes) d["shapes"].push_back(shape_json(s, page.shapes.size(), page.shapes[0]));
+  for (const ViewShape& s : page.shapes)
+    d["shapes"].push_back(shape_json(s, page.shapes.size(), page.shapes[0]));
   d["domain"] = {{"means", quantised(page.domain.means)}, {"sigma", page.domain.sigma}};
   if (page.texture.width > 0) {
     const std::string png = encode_png(page.texture);
