@@ -18,5 +18,6 @@ void add_chart(CLI::App& app);
 void add_correspond(CLI::App& app);
 void add_eval_corr(CLI::App& app);
 void add_show(CLI::App& app);
+void add_view(CLI::App& app);
 
 }  // namespace jsa::cli

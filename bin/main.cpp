@@ -5,8 +5,9 @@
 #include "engine/check.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"jsatlas: learn joint surface atlases of meshes and point clouds\n"
-               "(Deprelle, Groueix, Aigerman, Kim, Aubry: Learning Joint Surface Atlases, NeurIPS 2022)"};
+  CLI::App app{
+      "jsatlas: learn joint surface atlases of meshes and point clouds\n"
+      "(Deprelle, Groueix, Aigerman, Kim, Aubry: Learning Joint Surface Atlases, NeurIPS 2022)"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "jsatlas 0.1.0");
   jsa::cli::add_fit(app);
@@ -16,6 +17,7 @@ int main(int argc, char** argv) {
   jsa::cli::add_correspond(app);
   jsa::cli::add_eval(app);
   jsa::cli::add_eval_corr(app);
+  jsa::cli::add_view(app);
   // CLI11 would call an unknown word "extra arguments"; name it instead.
   if (argc > 1 && argv[1][0] != '-') {
     bool known = false;
@@ -25,7 +27,8 @@ int main(int argc, char** argv) {
       names += (names.empty() ? "" : ", ") + sub->get_name();
     }
     if (!known) {
-      std::cerr << "jsatlas: unknown command '" << argv[1] << "' (commands: " << names << "; see --help)\n";
+      std::cerr << "jsatlas: unknown command '" << argv[1] << "' (commands: " << names
+                << "; see --help)\n";
       return 2;
     }
   }

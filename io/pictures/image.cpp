@@ -97,17 +97,24 @@ Image read_image(const std::string& path) {
   return image;
 }
 
+std::string encode_png(const Image& image) {
+  JSA_CHECK(image.width > 0 && image.height > 0, "cannot encode an empty image");
+  std::string bytes;
+  // stb calls back with chunks of the encoded file; we append them.
+  auto append = [](void* out, void* data, int size) {
+    static_cast<std::string*>(out)->append(static_cast<const char*>(data), std::size_t(size));
+  };
+  const int ok = stbi_write_png_to_func(append, &bytes, image.width, image.height, 3,
+                                        image.rgb.data(), image.width * 3);
+  JSA_CHECK(ok != 0, "stb could not encode a " << image.width << " x " << image.height << " PNG");
+  return bytes;
+}
+
 void write_png(const std::string& path, const Image& image) {
   JSA_CHECK(image.width > 0 && image.height > 0, "cannot write an empty image to " << path);
-  write_file_atomically(path, [&](std::ostream& out) {
-    // stb calls back with chunks of the encoded file; we forward them to the stream.
-    auto forward = [](void* stream, void* data, int size) {
-      static_cast<std::ostream*>(stream)->write(static_cast<const char*>(data), size);
-    };
-    const int ok = stbi_write_png_to_func(forward, &out, image.width, image.height, 3,
-                                          image.rgb.data(), image.width * 3);
-    JSA_CHECK(ok != 0, "stb could not encode " << path);
-  });
+  const std::string bytes = encode_png(image);
+  write_file_atomically(
+      path, [&](std::ostream& out) { out.write(bytes.data(), std::streamsize(bytes.size())); });
 }
 
 // ---- drawing ----

@@ -48,6 +48,8 @@ Image read_image(const std::string& path);
 // Encodes a PNG with stb_image_write and writes it through write_file_atomically.
 // Throws InputError if the directory is missing or not writable.
 void write_png(const std::string& path, const Image& image);
+// The PNG file's bytes, in memory (for pages that inline their pictures).
+std::string encode_png(const Image& image);
 
 // ---- drawing (all clipped to the image; coordinates in pixels, y down) ----
 
