@@ -172,7 +172,7 @@ CutResult cut_charts(const Block<double>& positions, const Faces& faces, const B
     }
   }
   std::sort(half.begin(), half.end());
-  std::vector<int> neighbour(size_t(3 * F), -1);
+  std::vector<int> neighbour(size_t(3 * F), -1), torn_link(size_t(3 * F), -1);
   double uv_area = 0;
   for (int f = 0; f < F; ++f)
     if (valid[size_t(f)])
@@ -198,6 +198,8 @@ CutResult cut_charts(const Block<double>& positions, const Faces& faces, const B
         const double len2 = uv_scale * (uv_of(uv, a) - uv_of(uv, b)).norm();
         if (len2 > o.torn_ratio * len3) {
           ++out.torn_edges;
+          torn_link[size_t(h0)] = h1;
+          torn_link[size_t(h1)] = h0;
         } else {
           neighbour[size_t(h0)] = h1;
           neighbour[size_t(h1)] = h0;
@@ -297,6 +299,27 @@ CutResult cut_charts(const Block<double>& positions, const Faces& faces, const B
     }
   };
   grow();
+  // Faces cut off from every core by torn edges only (psi's UVs are unusable
+  // on both sides of a torn edge, so the tear says nothing there): they join
+  // the chart they touch across the torn edge, glued along the edge they
+  // enter by, and are laid out by the repair as an extension of that chart.
+  for (int f = 0; f < F; ++f)
+    if (face_chart[size_t(f)] >= 0) queue.push_back(f);
+  while (!queue.empty()) {
+    const int f = queue.front();
+    queue.pop_front();
+    for (int k = 0; k < 3; ++k) {
+      const int h = 3 * f + k;
+      const int nb = neighbour[size_t(h)] >= 0 ? neighbour[size_t(h)] : torn_link[size_t(h)];
+      if (nb < 0) continue;
+      const int g = nb / 3;
+      if (face_chart[size_t(g)] >= 0 || !valid[size_t(g)]) continue;
+      face_chart[size_t(g)] = face_chart[size_t(f)];
+      neighbour[size_t(h)] = nb;
+      neighbour[size_t(nb)] = h;
+      queue.push_back(g);
+    }
+  }
   // Faces no core reaches (components with no usable region): charts of their own.
   for (int f = 0; f < F; ++f) {
     if (!valid[size_t(f)] || face_chart[size_t(f)] >= 0) continue;
@@ -395,6 +418,67 @@ CutResult cut_charts(const Block<double>& positions, const Faces& faces, const B
     stack.push_back({a, ida, p.sign, p.depth + 1});
   }
   for (int f = 0; f < F; ++f) out.unusable_faces += valid[size_t(f)] && !usable[size_t(f)];
+  return out;
+}
+
+}  // namespace jsa
+
+namespace jsa {
+
+std::vector<ChartMesh> split_chart(const ChartMesh& m) {
+  const int n = int(m.faces.size());
+  if (n < 2) return {};
+  // Local adjacency: half-edges glued when the chart has the twin b -> a.
+  std::vector<std::pair<std::pair<int, int>, int>> half;
+  for (int f = 0; f < n; ++f)
+    for (int k = 0; k < 3; ++k)
+      half.push_back({{m.local(f, k), m.local(f, (k + 1) % 3)}, 3 * f + k});
+  std::sort(half.begin(), half.end());
+  std::vector<int> neighbour(size_t(3 * n), -1);
+  for (const auto& [edge, h] : half) {
+    auto it = std::lower_bound(half.begin(), half.end(),
+                               std::make_pair(std::make_pair(edge.second, edge.first), -1));
+    if (it != half.end() && it->first == std::make_pair(edge.second, edge.first))
+      neighbour[size_t(h)] = it->second;
+  }
+  std::vector<int> chart_of(size_t(n), 0), dist(size_t(n), -1);
+  auto sweep = [&](int seed) {
+    std::fill(dist.begin(), dist.end(), -1);
+    return bfs_order(seed, neighbour, chart_of, 0, dist);
+  };
+  const int s1 = sweep(0).back();
+  const std::vector<int> d1 = (sweep(s1), dist);
+  const int s2 = sweep(s1).back();
+  const std::vector<int> d2 = (sweep(s2), dist);
+  std::vector<int> side(static_cast<size_t>(n));
+  for (int f = 0; f < n; ++f)
+    side[size_t(f)] = d1[size_t(f)] >= 0 && d1[size_t(f)] <= d2[size_t(f)] ? 0 : 1;
+  // Sub-charts in the local numbering, then mapped back to input ids.
+  Faces as_faces = m.local;
+  std::vector<ChartMesh> out;
+  for (int s = 0; s < 2; ++s) {
+    std::vector<int> members;
+    for (int f = 0; f < n; ++f)
+      if (side[size_t(f)] == s) members.push_back(f);
+    if (members.empty()) return {};
+    std::vector<int> glued = neighbour;
+    for (int f = 0; f < n; ++f)
+      for (int k = 0; k < 3; ++k) {
+        const int nb = glued[size_t(3 * f + k)];
+        if (nb >= 0 && side[size_t(nb / 3)] != side[size_t(f)]) glued[size_t(3 * f + k)] = -1;
+      }
+    // build_chart_mesh reads edge l of the neighbour as running b -> a, as here.
+    ChartMesh sub = build_chart_mesh(as_faces, members, glued, side, s);
+    if (!chart_topology(sub).is_disk()) return {};
+    for (size_t i = 0; i < sub.faces.size(); ++i) {
+      const int f = sub.faces[i];
+      sub.usable[i] = m.usable[size_t(f)];
+      sub.faces[i] = m.faces[size_t(f)];
+    }
+    for (int& v : sub.vertex) v = m.vertex[size_t(v)];
+    sub.orientation = m.orientation;
+    out.push_back(std::move(sub));
+  }
   return out;
 }
 

@@ -79,3 +79,13 @@ ChartTopology chart_topology(const ChartMesh& chart);
 std::vector<std::vector<int>> boundary_loops(const Faces& local, Index vertex_count);
 
 }  // namespace jsa
+
+namespace jsa {
+
+// A disk chart cut in two along the dual graph: faces go to the nearer of two
+// far-apart seeds (a double breadth-first sweep). Returns the two halves (with
+// their own local vertices, usable flags and orientation), or nothing if the
+// chart has one face or a half is not a disk.
+std::vector<ChartMesh> split_chart(const ChartMesh& chart);
+
+}  // namespace jsa

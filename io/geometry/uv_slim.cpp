@@ -90,7 +90,8 @@ double max_injective_step(const Faces& local, const Block<double>& uv, const Blo
 }
 
 SlimReport slim_symmetric_dirichlet(const Block<double>& positions, const Faces& local,
-                                    Block<double>& uv, const SlimOptions& o) {
+                                    Block<double>& uv, const SlimOptions& o,
+                                    const std::function<bool(const Block<double>&)>& accept) {
   const auto start = std::chrono::steady_clock::now();
   const Index V = uv.rows(), F = local.rows();
   const std::vector<TriangleFrame> frames = triangle_frames(positions, local);
@@ -208,6 +209,7 @@ SlimReport slim_symmetric_dirichlet(const Block<double>& positions, const Faces&
       if (e_trial < energy) break;
     }
     if (!(e_trial < energy)) break;
+    if (accept && !accept(trial)) break;
     const double gain = (energy - e_trial) / energy;
     uv.swap(trial);
     energy = e_trial;

@@ -11,6 +11,7 @@
 // the step per triangle), then halved until the energy decreases. Started from
 // an injective map it stays locally injective; the caller checks the boundary.
 #pragma once
+#include <functional>
 #include <vector>
 
 #include "io/geometry/triangle_frame.h"
@@ -43,7 +44,10 @@ double symmetric_dirichlet(const std::vector<TriangleFrame>& frames, const Faces
 double max_injective_step(const Faces& local, const Block<double>& uv, const Block<double>& d);
 
 // Minimises D in place from an injective uv (every triangle counter-clockwise).
+// `accept`, if given, is asked about each new iterate: on false the iterations
+// stop at the previous one (e.g. the chart's boundary started to overlap itself).
 SlimReport slim_symmetric_dirichlet(const Block<double>& positions, const Faces& local,
-                                    Block<double>& uv, const SlimOptions& options = {});
+                                    Block<double>& uv, const SlimOptions& options = {},
+                                    const std::function<bool(const Block<double>&)>& accept = {});
 
 }  // namespace jsa

@@ -17,6 +17,7 @@ struct ChartOut {
   std::vector<int> faces;  // input faces
   Faces local;             // into uv
   Block<double> uv;        // final (aligned) UVs
+  Block<double> uv3;       // the same before alignment, at the 3D scale (what the packer takes)
   double area = 0;         // UV area
   ChartStart start = ChartStart::failed;
   bool reverted = false, mirrored = false, single = false;
@@ -50,6 +51,7 @@ ChartOut single_face(const Block<double>& positions, const Faces& faces, const B
   c.uv = Block<double>::Zero(3, 2);
   c.uv.row(1) << l1, 0;
   c.uv.row(2) << e1.dot(e2) / l1, e1.cross(e2).norm() / l1;
+  c.uv3 = c.uv;
   c.uv = fit_similarity(c.uv, target).apply(c.uv);
   c.area = uv_area(c.local, c.uv);
   c.start = ChartStart::tutte;
@@ -58,7 +60,8 @@ ChartOut single_face(const Block<double>& positions, const Faces& faces, const B
 
 std::vector<ChartOut> process_chart(const Block<double>& positions, const Faces& faces,
                                     const Block<double>& psi_uv, const ChartMesh& m,
-                                    const SlimOptions& slim_options) {
+                                    const ValidUvOptions& o, int depth = 0) {
+  const SlimOptions& slim_options = o.slim;
   const Index Vc = Index(m.vertex.size());
   Block<double> pos(Vc, 3), psi(Vc, 2);
   for (Index v = 0; v < Vc; ++v) {
@@ -91,7 +94,11 @@ std::vector<ChartOut> process_chart(const Block<double>& positions, const Faces&
   c.start = start.start;
   c.mirrored = m.orientation < 0;
   Block<double> uv = start.uv;
-  const SlimReport rep = slim_symmetric_dirichlet(pos, m.local, uv, slim_options);
+  // Each iterate keeps every triangle positive; the boundary is checked too, so
+  // the last iterate whose boundary is simple (hence injective) is kept.
+  const SlimReport rep = slim_symmetric_dirichlet(
+      pos, m.local, uv, slim_options,
+      [&](const Block<double>& x) { return !boundary_self_intersects(m.local, x); });
   c.iterations = rep.iterations;
   for (Index f = 0; f < m.local.rows(); ++f) {
     const Eigen::RowVector3d p0 = pos.row(m.local(f, 0)), p1 = pos.row(m.local(f, 1)),
@@ -112,6 +119,7 @@ std::vector<ChartOut> process_chart(const Block<double>& positions, const Faces&
       for (int k = 0; k < 3; ++k) w[size_t(m.local(f, k))] += 1;
   if (std::all_of(w.begin(), w.end(), [](double x) { return x == 0; }))
     for (Index v = 0; v < Vc; ++v) w[size_t(v)] = psi.row(v).allFinite() ? 1.0 : 0.0;
+  c.uv3 = uv;
   c.uv = fit_similarity(uv, psi, w).apply(uv);
   if (m.orientation < 0) {
     // Back to psi's place: the mirrored target's centroid is psi's mirrored.
@@ -121,6 +129,17 @@ std::vector<ChartOut> process_chart(const Block<double>& positions, const Faces&
     c.uv.col(0).array() -= 2 * cx / sw;
   }
   c.area = uv_area(c.local, c.uv);
+  // Still far from an isometry (SLIM was stopped by the boundary, or the chart
+  // cannot flatten): cut it in two and do each half again.
+  if (c.energy_end > o.split_energy && depth < o.max_split_depth) {
+    std::vector<ChartMesh> halves = split_chart(m);
+    if (halves.size() == 2) {
+      std::vector<ChartOut> out = process_chart(positions, faces, psi_uv, halves[0], o, depth + 1);
+      for (ChartOut& h : process_chart(positions, faces, psi_uv, halves[1], o, depth + 1))
+        out.push_back(std::move(h));
+      return out;
+    }
+  }
   return {std::move(c)};
 }
 
@@ -152,7 +171,7 @@ ValidUv make_valid_uv(const Block<double>& positions, const Faces& faces,
   for (const ChartMesh& m : cut.charts) total += double(m.faces.size());
   report("charts", 0);
   for (size_t i = 0; i < large; ++i) {
-    results[order[i]] = process_chart(positions, faces, psi_uv, cut.charts[order[i]], o.slim);
+    results[order[i]] = process_chart(positions, faces, psi_uv, cut.charts[order[i]], o);
     done += double(cut.charts[order[i]].faces.size());
     report("charts", done / std::max(total, 1.0));
   }
@@ -160,7 +179,7 @@ ValidUv make_valid_uv(const Block<double>& positions, const Faces& faces,
 #pragma omp parallel for schedule(dynamic, 1)
   for (long long i = (long long)large; i < (long long)n; ++i)
     results[order[size_t(i)]] =
-        process_chart(positions, faces, psi_uv, cut.charts[order[size_t(i)]], o.slim);
+        process_chart(positions, faces, psi_uv, cut.charts[order[size_t(i)]], o);
   report("charts", 1);
 
   std::vector<ChartOut> charts;
@@ -188,9 +207,11 @@ ValidUv make_valid_uv(const Block<double>& positions, const Faces& faces,
     report("pack", 0);
     std::vector<Block<double>> uvs;
     std::vector<double> areas;
+    // Packed charts keep their 3D scale (one texel density everywhere): psi's
+    // placement is given up by packing anyway, and psi's local scale need not be uniform.
     for (ChartOut& c : charts) {
-      uvs.push_back(std::move(c.uv));
-      areas.push_back(c.area);
+      uvs.push_back(std::move(c.uv3));
+      areas.push_back(uv_area(c.local, uvs.back()));
     }
     const PackResult p = pack_charts(uvs, areas, o.pack);
     for (size_t i = 0; i < charts.size(); ++i) charts[i].uv = std::move(uvs[i]);

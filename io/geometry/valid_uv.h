@@ -26,6 +26,11 @@ struct ValidUvOptions {
   // Charts with at least this many faces run one at a time with OpenMP inside
   // (over triangles); the smaller ones run in parallel with each other.
   int large_chart_faces = 20000;
+  // A chart whose symmetric Dirichlet energy (4 for an isometry) stays above
+  // this after optimisation is cut in two and each half redone, at most
+  // max_split_depth times: more charts, less distortion.
+  double split_energy = 8;
+  int max_split_depth = 8;
 };
 
 // stage ("cut", "charts", "pack") and the fraction of it done, from the calling thread only.
