@@ -8,11 +8,11 @@
 #include "io/atomic_write.h"
 #include "io/geometry/valid_uv.h"
 #include "io/mesh_io.h"
+#include "io/pictures/raster.h"
+#include "io/pictures/run_pictures.h"
 #include "losses/metrics/uv_quality.h"
 #include "model/tool/chart_mesh.h"
 #include "model/tool/domain_mesh.h"
-#include "io/pictures/run_pictures.h"
-#include "io/pictures/raster.h"
 
 namespace jsa::cli {
 namespace {

@@ -14,8 +14,8 @@
 #include <functional>
 #include <vector>
 
-#include "io/geometry/triangle_frame.h"
 #include "io/geometry/mesh.h"
+#include "io/geometry/triangle_frame.h"
 
 namespace jsa {
 
