@@ -1,17 +1,18 @@
 #include "bin/run_files.h"
 
+#include <chrono>
 #include <filesystem>
 #include <iostream>
-
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_write.h"
+#include "io/geometry/valid_uv.h"
 #include "io/mesh_io.h"
+#include "io/pictures/raster.h"
+#include "io/pictures/run_pictures.h"
 #include "losses/metrics/uv_quality.h"
 #include "model/tool/chart_mesh.h"
 #include "model/tool/domain_mesh.h"
-#include "io/pictures/run_pictures.h"
-#include "io/pictures/raster.h"
 
 namespace jsa::cli {
 namespace {
@@ -47,66 +48,159 @@ void write_report(const std::string& path, const UvQuality& q, const nlohmann::j
   write_file_atomically(path, [&](std::ostream& out) { out << j.dump(2) << "\n"; });
 }
 
+nlohmann::json stats_json(const ValidUvStats& s, bool packed) {
+  nlohmann::json j;
+  j["charts"] = s.charts;
+  j["charts_from_psi"] = s.from_psi;
+  j["charts_repaired"] = s.repaired;
+  j["charts_tutte"] = s.tutte;
+  j["single_faces"] = s.single_faces;
+  j["slim_reverted"] = s.slim_reverted;
+  j["mirrored_charts"] = s.mirrored_charts;
+  j["slim_iterations"] = s.slim_iterations;
+  j["symmetric_dirichlet_start"] = s.energy_start;
+  j["symmetric_dirichlet_end"] = s.energy_end;
+  j["packed"] = packed;
+  j["packing_efficiency"] = s.packing_efficiency;
+  j["padding_texels"] = s.padding_texels;
+  j["torn_edges_cut"] = s.cut.torn_edges;
+  j["nonmanifold_edges"] = s.cut.nonmanifold_edges;
+  j["inconsistent_edges"] = s.cut.inconsistent_edges;
+  j["boundary_edges"] = s.cut.boundary_edges;
+  j["skipped_faces"] = s.cut.skipped_faces.size();
+  j["charts_split_to_disks"] = s.cut.split_charts;
+  j["faces_psi_unusable"] = s.cut.unusable_faces;
+  j["seconds"] = s.seconds;
+  j["warnings"] = s.warnings;
+  return j;
+}
+
+// One 3D vertex per UV index, so per-vertex renderers draw seamed UVs.
+Block<double> unweld(const Block<double>& vertices, const Faces& faces, const Faces& uv_faces,
+                     Index uv_count) {
+  Block<double> out = Block<double>::Zero(uv_count, 3);
+  for (Index f = 0; f < faces.rows(); ++f)
+    for (int k = 0; k < 3; ++k) out.row(uv_faces(f, k)) = vertices.row(faces(f, k));
+  return out;
+}
+
 }  // namespace
+
+Block<double> shared_layout(const Block<double>& frame_uv, int texture_size, double padding) {
+  const double p = std::clamp(padding / std::max(texture_size, 1), 0.0, 0.25);
+  return (frame_uv.array() * (1 - 2 * p) + p).matrix();
+}
 
 std::string json_quote(const std::string& s) { return nlohmann::json(s).dump(); }
 
 void write_domain_mesh(Atlas<float>& atlas, const Normalization& normalization,
                        const std::string& obj_path, const MeshOutputOptions& o, int shape) {
+  const auto start = std::chrono::steady_clock::now();
   const DomainMesh dm = mesh_domain(atlas, DomainMeshOptions{o.resolution, o.threshold});
   if (dm.faces.rows() == 0)
-    throw InputError("mesh: no domain above the threshold " + std::to_string(o.threshold) + " (lower --threshold)");
+    throw InputError("mesh: no domain above the threshold " + std::to_string(o.threshold) +
+                     " (lower --threshold)");
   Mesh out;
   Block<double> points, normals;
   evaluate_surface(atlas, dm.uv, points, normals, shape);
   out.vertices = normalization.from_unit(points);
   out.normals = normals;
   out.faces = dm.faces;
-  const Block<double> vt = texture_frame(atlas).to_texture(dm.uv);
+  // The domain's grid is one injective chart by construction; its UVs are the
+  // shared layout (the TextureFrame inset by the padding), the same on every shape.
+  const Block<double> vt =
+      shared_layout(texture_frame(atlas).to_texture(dm.uv), o.texture_size, o.padding);
   write_obj(obj_path, out, &vt, write_material(obj_path, o.texture), "atlas");
   const std::string stem = stem_of(obj_path);
   const UvQuality q = measure_uv_quality(out.vertices, out.faces, vt, out.faces);
-  write_report(stem + "_uv.json", q, {{"domain_mass_fraction", dm.mass_fraction}, {"threshold", o.threshold},
-                                      {"level", dm.level}, {"map", "domain uv -> phi (3D)"}});
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  write_report(stem + "_uv.json", q,
+               {{"domain_mass_fraction", dm.mass_fraction},
+                {"threshold", o.threshold},
+                {"level", dm.level},
+                {"map", "domain uv -> phi (3D)"},
+                {"seconds", seconds},
+                {"padding_texels", o.padding},
+                {"texture_size", o.texture_size}});
   write_png(stem + ".png", domain_coloured_views(out.vertices, out.faces, vt));
   if (!o.quiet) {
-    std::cerr << "mesh: " << obj_path << "  (" << out.vertices.rows() << " vertices, " << out.faces.rows()
-              << " triangles; the domain holds " << int(100 * dm.mass_fraction + 0.5) << "% of P's mass)\n";
+    std::cerr << "mesh: " << obj_path << "  (" << out.vertices.rows() << " vertices, "
+              << out.faces.rows() << " triangles; the domain holds "
+              << int(100 * dm.mass_fraction + 0.5) << "% of P's mass)\n";
     std::cerr << to_text(q);
   }
 }
 
-void write_chart(Atlas<float>& atlas, const Normalization& normalization, const Mesh& mesh,
-                 const std::string& obj_path, const ChartOutputOptions& o, int shape) {
-  if (mesh.faces.rows() == 0) throw InputError("chart: the input has no faces (a point cloud has no UV map to write)");
+ChartWritten write_chart(Atlas<float>& atlas, const Normalization& normalization, const Mesh& mesh,
+                         const std::string& obj_path, const ChartOutputOptions& o, int shape) {
+  if (mesh.faces.rows() == 0)
+    throw InputError("chart: the input has no faces (a point cloud has no UV map to write)");
+  const auto start = std::chrono::steady_clock::now();
   const Block<double> uv = chart_vertices(atlas, mesh, normalization, shape);
   const TextureFrame frame = texture_frame(atlas);
-  Block<double> vt = frame.to_texture(uv);
+  const Block<double> psi_vt = frame.to_texture(uv);
   UvQualityOptions qo;
   qo.torn_ratio = o.torn_ratio;
-  UvQuality q = measure_uv_quality(mesh.vertices, mesh.faces, vt, mesh.faces, qo);
-  Faces uv_faces = mesh.faces;
-  const Index torn_before = q.torn;
-  if (o.split_cuts && q.torn > 0) {
-    SplitUv split = split_torn(atlas, mesh, normalization, uv, q.torn_faces, shape);
-    vt = frame.to_texture(split.uv);
-    uv_faces = split.uv_faces;
-    q = measure_uv_quality(mesh.vertices, mesh.faces, vt, uv_faces, qo);
+  const UvQuality psi_q = measure_uv_quality(mesh.vertices, mesh.faces, psi_vt, mesh.faces, qo);
+  ChartWritten w;
+  w.vt = psi_vt;
+  w.uv_faces = mesh.faces;
+  nlohmann::json extra = {{"map", "input mesh -> psi (2D); measured as uv -> 3D"}};
+  std::string summary;
+  if (o.psi_only) {
+    if (o.split_cuts && psi_q.torn > 0) {
+      SplitUv split = split_torn(atlas, mesh, normalization, uv, psi_q.torn_faces, shape);
+      w.vt = frame.to_texture(split.uv);
+      w.uv_faces = split.uv_faces;
+    }
+    extra["uvs"] = o.split_cuts ? "psi, torn faces split" : "psi as is";
+    summary = std::to_string(psi_q.torn) + " torn across the cut" +
+              (o.split_cuts ? ", split" : "") + "; psi's UVs";
+  } else {
+    ValidUvOptions vo;
+    vo.pack_charts = o.pack;
+    vo.pack.texture_size = o.texture_size;
+    vo.pack.padding = o.padding;
+    UvProgress progress;
+    if (!o.quiet && mesh.faces.rows() >= 100000)
+      progress = [](const std::string& stage, double x) {
+        std::cerr << "chart: " << stage << " " << int(100 * x + 0.5) << "%\n";
+      };
+    const ValidUv v = make_valid_uv(mesh.vertices, mesh.faces, psi_vt, vo, progress);
+    w.vt = o.pack ? v.uv : shared_layout(v.uv, o.texture_size, o.padding);
+    w.uv_faces = v.uv_faces;
+    extra["uvs"] = o.pack ? "valid, packed" : "valid, shared-domain layout (not packed)";
+    extra["valid_uv"] = stats_json(v.stats, o.pack);
+    extra["psi"] = nlohmann::json::parse(to_json(psi_q));
+    extra["psi"].erase("torn_faces");
+    extra["psi"].erase("flipped_faces");
+    for (const std::string& warning : v.stats.warnings)
+      if (!o.quiet) std::cerr << "warning: chart: " << warning << "\n";
+    char line[200];
+    std::snprintf(line, sizeof line,
+                  "%lld charts (%lld from psi, %lld repaired, %lld Tutte); %.2f s",
+                  (long long)v.stats.charts, (long long)v.stats.from_psi,
+                  (long long)v.stats.repaired, (long long)v.stats.tutte, v.stats.seconds);
+    summary = line;
   }
-  write_obj(obj_path, mesh, &vt, write_material(obj_path, o.texture), "atlas", o.split_cuts ? &uv_faces : nullptr);
+  const UvQuality q = measure_uv_quality(mesh.vertices, mesh.faces, w.vt, w.uv_faces, qo);
+  const bool split = o.split_cuts || !o.psi_only;
+  write_obj(obj_path, mesh, &w.vt, write_material(obj_path, o.texture), "atlas",
+            split ? &w.uv_faces : nullptr);
   const std::string stem = stem_of(obj_path);
-  write_report(stem + "_uv.json", q, {{"map", "input mesh -> psi (2D); measured as uv -> 3D"},
-                                      {"split_cuts", o.split_cuts}, {"torn_before_split", torn_before}});
-  const Block<double> vertex_vt = frame.to_texture(uv);
-  write_png(stem + ".png", domain_coloured_views(mesh.vertices, mesh.faces, vertex_vt));
-  write_png(stem + "_layout.png",
-            uv_layout_picture(mesh.vertices, mesh.faces, vt, uv_faces, q.flipped_faces, q.torn_faces));
+  extra["seconds"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  write_report(stem + "_uv.json", q, extra);
+  write_png(stem + ".png", domain_coloured_views(mesh.vertices, mesh.faces, psi_vt));
+  write_png(stem + "_layout.png", uv_layout_picture(mesh.vertices, mesh.faces, w.vt, w.uv_faces,
+                                                    q.flipped_faces, q.torn_faces));
   if (!o.quiet) {
-    std::cerr << "chart: " << obj_path << "  (" << mesh.vertices.rows() << " vertices, " << mesh.faces.rows()
-              << " faces in the input's order; " << torn_before << " torn across the cut"
-              << (o.split_cuts ? ", split" : "") << ")\n";
+    std::cerr << "chart: " << obj_path << "  (" << mesh.vertices.rows() << " vertices, "
+              << mesh.faces.rows() << " faces in the input's order; " << summary << ")\n";
     std::cerr << to_text(q);
   }
+  return w;
 }
 
 void write_run_outputs(Atlas<float>& atlas, const std::vector<RunInput>& inputs, const LossLog& log,
@@ -127,14 +221,23 @@ void write_run_outputs(Atlas<float>& atlas, const std::vector<RunInput>& inputs,
       ChartOutputOptions co;
       co.quiet = mesh.quiet;
       co.texture = mesh.texture;
-      write_chart(atlas, inputs[i].normalization, inputs[i].mesh, sub + "/input_chart.obj", co, int(i));
+      co.texture_size = mesh.texture_size;
+      co.padding = mesh.padding;
+      // A texture painted in the shared domain fits every shape only through
+      // the shared layout: with --texture the charts stay unpacked.
+      co.pack = mesh.texture.empty();
+      const ChartWritten written = write_chart(atlas, inputs[i].normalization, inputs[i].mesh,
+                                               sub + "/input_chart.obj", co, int(i));
       // One view per shape, coloured by its position in the shared domain
-      // (and, with a texture, textured through its chart).
+      // (and, with a texture, textured through its valid, seamed UVs).
       const Mesh& m = inputs[i].mesh;
-      const Block<double> vt =
-          texture_frame(atlas).to_texture(chart_vertices(atlas, m, inputs[i].normalization, int(i)));
+      const Block<double> vt = texture_frame(atlas).to_texture(
+          chart_vertices(atlas, m, inputs[i].normalization, int(i)));
       if (collection) coloured.push_back(domain_coloured_views(m.vertices, m.faces, vt, 320));
-      if (texture.width > 0) textured.push_back(textured_views(m.vertices, m.faces, vt, texture, 320));
+      if (texture.width > 0)
+        textured.push_back(
+            textured_views(unweld(m.vertices, m.faces, written.uv_faces, written.vt.rows()),
+                           written.uv_faces, written.vt, texture, 320));
       captions.push_back("shape " + std::to_string(i));
     }
   }

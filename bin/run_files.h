@@ -13,10 +13,12 @@ namespace jsa::cli {
 std::string json_quote(const std::string& s);
 
 struct MeshOutputOptions {
-  int resolution = 256;    // grid cells across the domain
+  int resolution = 256;     // grid cells across the domain
   double threshold = 0.05;  // domain = {P >= threshold * median of P at the means}
   bool quiet = false;
   std::string texture;      // the user's image for the MTLs (empty: the built-in colour chart)
+  int texture_size = 1024;  // texels per side of the texture the UVs are laid out for
+  double padding = 4;       // texels kept free around charts and along the border
 };
 // OUT.obj (+ .mtl, texture PNG, _uv.json report, .png three views): the
 // thresholded domain mapped through phi, in the input's frame.
@@ -24,15 +26,30 @@ void write_domain_mesh(Atlas<float>& atlas, const Normalization& normalization,
                        const std::string& obj_path, const MeshOutputOptions& o, int shape = 0);
 
 struct ChartOutputOptions {
-  bool split_cuts = false;  // give torn triangles their own UV corners (no smeared triangles)
-  double torn_ratio = 10;   // a UV edge this many times longer than its 3D edge is torn
+  bool psi_only = false;    // write psi's UVs as they are (no cut, repair or packing): the "before"
+  bool split_cuts = false;  // with psi_only: give torn triangles their own UV corners
+  double torn_ratio = 10;   // a UV edge this many times longer than its 3D edge is torn (report)
+  bool pack = true;  // pack the valid charts into [0,1]^2; false keeps psi's shared-domain layout
+  int texture_size = 1024;  // texels per side of the texture the UVs are laid out for
+  double padding = 4;  // texels between packed charts (and the border inset of the shared layout)
   bool quiet = false;
-  std::string texture;      // the user's image for the MTL (empty: the built-in colour chart)
+  std::string texture;  // the user's image for the MTL (empty: the built-in colour chart)
 };
-// OUT.obj with the user's vertices and faces in their order and vt from psi,
-// OUT_uv.json, OUT.png (three views coloured through the chart), OUT_layout.png.
-void write_chart(Atlas<float>& atlas, const Normalization& normalization, const Mesh& mesh,
-                 const std::string& obj_path, const ChartOutputOptions& o, int shape = 0);
+// OUT.obj with the user's vertices and faces in their order and valid UVs
+// (io/geometry/valid_uv.h: psi's layout cut where it tears or folds, made
+// injective, packed), OUT_uv.json (the UV report of the written map, and of
+// psi's own UVs under "psi"), OUT.png (three views coloured through the
+// chart), OUT_layout.png.
+struct ChartWritten {
+  Block<double> vt;  // the written texture coordinates
+  Faces uv_faces;    // F x 3 into vt
+};
+ChartWritten write_chart(Atlas<float>& atlas, const Normalization& normalization, const Mesh& mesh,
+                         const std::string& obj_path, const ChartOutputOptions& o, int shape = 0);
+
+// Texture coordinates of the shared layout: the TextureFrame inset by `padding`
+// texels of a texture_size texture, the same for every shape of a collection.
+Block<double> shared_layout(const Block<double>& frame_uv, int texture_size, double padding);
 
 // Everything at the end of `fit`: domain_mesh.*, input_chart.* (for mesh
 // inputs), domain.png, losses.png; for a collection the per-shape files go to

@@ -42,7 +42,7 @@ TEST_CASE("cli: fit writes every output and the follow-up commands read them", "
   // The chart keeps the input's vertex count and face order.
   const std::string chart = read_text(dir + "/input_chart.obj");
   CHECK(chart.find("vt ") != std::string::npos);
-  r = run("chart " + dir + " -o " + dir + "/again.obj --split-cuts -q");
+  r = run("chart " + dir + " -o " + dir + "/again.obj --psi-only --split-cuts -q");
   CHECK(r.code == 0);
   r = run("mesh " + dir + " -o " + dir + "/m.obj --resolution 40 -q");
   CHECK(r.code == 0);
@@ -121,22 +121,28 @@ TEST_CASE("cli: SIGKILL at a random moment leaves a loadable checkpoint", "[cli]
 }
 
 TEST_CASE(
-    "cli: the chart OBJ reads back in tinyobjloader with one vt per input vertex, faces in order",
+    "cli: the chart OBJ reads back in tinyobjloader with the input's vertices, faces in order",
     "[cli]") {
   const std::string dir = fresh_dir("objback");
   REQUIRE(run("fit builtin:torus -o " + dir + " --iters 10" + kSmall).code == 0);
   const jsa::Mesh input = jsa::builtin_shape("torus");
-  for (const bool split : {false, true}) {
-    const std::string path = split ? dir + "/split.obj" : dir + "/input_chart.obj";
-    if (split)
-      REQUIRE(run("chart " + dir + " -o " + path + " --split-cuts --torn-ratio 2 -q").code == 0);
+  // psi: psi's UVs, one vt per vertex; split: the same with torn faces split;
+  // valid: input_chart.obj as fit writes it (seams split vt, packed in [0, 1]).
+  for (const std::string mode : {"psi", "split", "valid"}) {
+    INFO(mode);
+    const std::string path = mode == "valid" ? dir + "/input_chart.obj" : dir + "/" + mode + ".obj";
+    if (mode == "psi") REQUIRE(run("chart " + dir + " -o " + path + " --psi-only -q").code == 0);
+    if (mode == "split")
+      REQUIRE(
+          run("chart " + dir + " -o " + path + " --psi-only --split-cuts --torn-ratio 2 -q").code ==
+          0);
     tinyobj::ObjReader reader;
     REQUIRE(reader.ParseFromFile(path));
     const auto& attrib = reader.GetAttrib();
     REQUIRE(reader.GetShapes().size() == 1);
     const auto& indices = reader.GetShapes()[0].mesh.indices;
     CHECK(attrib.vertices.size() == size_t(3 * input.vertices.rows()));
-    if (!split)
+    if (mode == "psi")
       CHECK(attrib.texcoords.size() == size_t(2 * input.vertices.rows()));
     else
       CHECK(attrib.texcoords.size() >= size_t(2 * input.vertices.rows()));
@@ -144,9 +150,11 @@ TEST_CASE(
     bool same_order = true, uv_in_range = true;
     for (size_t k = 0; k < indices.size(); ++k) {
       same_order = same_order && indices[k].vertex_index == input.faces(Index(k / 3), int(k % 3));
-      if (!split) same_order = same_order && indices[k].texcoord_index == indices[k].vertex_index;
+      if (mode == "psi")
+        same_order = same_order && indices[k].texcoord_index == indices[k].vertex_index;
     }
-    for (float t : attrib.texcoords) uv_in_range = uv_in_range && t > -0.5f && t < 1.5f;
+    const float lo = mode == "valid" ? 0.f : -0.5f, hi = mode == "valid" ? 1.f : 1.5f;
+    for (float t : attrib.texcoords) uv_in_range = uv_in_range && t >= lo && t <= hi;
     CHECK(same_order);
     CHECK(uv_in_range);
   }

@@ -209,7 +209,8 @@ UvQuality measure_uv_quality(const Block<double>& positions, const Faces& faces,
   UvQuality q;
   q.triangles = F;
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  q.stretch_l2 = q.stretch_linf = q.symmetric_dirichlet = q.conformal_distortion = nan;
+  q.stretch_l2 = q.stretch_linf = q.symmetric_dirichlet = q.conformal_distortion =
+      q.area_distortion = nan;
   if (F == 0) return q;
 
   auto p = [&](Index f, int c) -> Eigen::Vector3d {
@@ -279,7 +280,7 @@ UvQuality measure_uv_quality(const Block<double>& positions, const Faces& faces,
   q.mirrored = negative > positive;
 
   double measured_area = 0, flipped_area = 0, torn_area = 0;
-  double sum_l2 = 0, sum_dirichlet = 0, sum_conformal = 0, max_sigma = 0;
+  double sum_l2 = 0, sum_dirichlet = 0, sum_conformal = 0, sum_area = 0, max_sigma = 0;
   for (Index f = 0; f < F; ++f) {
     if (degenerate[f]) ++q.degenerate;
     if (torn[f]) {
@@ -299,6 +300,7 @@ UvQuality measure_uv_quality(const Block<double>& positions, const Faces& faces,
     sum_l2 += w * 0.5 * (G * G + g * g);
     sum_dirichlet += w * (G * G + g * g + 1 / (G * G) + 1 / (g * g));
     sum_conformal += w * G / g;
+    sum_area += w * std::max(G * g, 1 / (G * g));  // Gamma gamma: 3D area / scaled UV area
     max_sigma = std::max(max_sigma, G);
   }
   if (q.area_3d > 0) {
@@ -310,6 +312,13 @@ UvQuality measure_uv_quality(const Block<double>& positions, const Faces& faces,
     q.stretch_linf = max_sigma;
     q.symmetric_dirichlet = sum_dirichlet / measured_area;
     q.conformal_distortion = sum_conformal / measured_area;
+    q.area_distortion = sum_area / measured_area;
+  }
+  // Packing: UV area over the box that holds the UVs and the unit square.
+  if (uv.rows() > 0) {
+    const Eigen::RowVector2d lo = uv.colwise().minCoeff().cwiseMin(Eigen::RowVector2d(0, 0));
+    const Eigen::RowVector2d hi = uv.colwise().maxCoeff().cwiseMax(Eigen::RowVector2d(1, 1));
+    q.packing_efficiency = q.area_uv / ((hi(0) - lo(0)) * (hi(1) - lo(1)));
   }
 
   // Overlap: every triangle except the torn ones (degenerate ones cover nothing).
@@ -378,6 +387,8 @@ std::string to_json(const UvQuality& q, int indent) {
   j["stretch_linf"] = number(q.stretch_linf);
   j["symmetric_dirichlet"] = number(q.symmetric_dirichlet);
   j["conformal_distortion"] = number(q.conformal_distortion);
+  j["area_distortion"] = number(q.area_distortion);
+  j["packing_efficiency"] = q.packing_efficiency;
   j["overlap_ratio"] = q.overlap_ratio;
   j["seam_length"] = q.seam_length;
   j["charts"] = q.charts;
@@ -414,11 +425,13 @@ std::string to_text(const UvQuality& q) {
   row("stretch L2", num(q.stretch_l2), "ideal 1");
   row("stretch Linf", num(q.stretch_linf), "ideal 1");
   row("symmetric Dirichlet", num(q.symmetric_dirichlet), "ideal 4");
-  row("conformal distortion", num(q.conformal_distortion), "ideal 1");
+  row("conformal distortion", num(q.conformal_distortion), "ideal 1; angle distortion");
+  row("area distortion", num(q.area_distortion), "ideal 1");
   row("overlap ratio", num(q.overlap_ratio), "ideal 0; torn not drawn");
   row("seam length", num(q.seam_length), "3D length of UV cuts");
   row("charts", std::to_string(q.charts), "");
   row("charts without torn", std::to_string(q.charts_without_torn), "");
+  row("packing efficiency", num(q.packing_efficiency), "UV area / box with the unit square");
   return s.str();
 }
 

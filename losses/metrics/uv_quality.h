@@ -45,13 +45,17 @@ struct UvQuality {
   double stretch_l2 = 0;             // sqrt(sum A3 (Gamma^2 + gamma^2) / 2 / sum A3), Sander et al.
   double stretch_linf = 0;           // max Gamma
   double symmetric_dirichlet = 0;    // mean over A3 of Gamma^2 + gamma^2 + Gamma^-2 + gamma^-2
-  double conformal_distortion = 0;   // mean over A3 of Gamma / gamma
+  double conformal_distortion = 0;   // mean over A3 of Gamma / gamma: the angle distortion
+  double area_distortion = 0;        // mean over A3 of max(Gamma gamma, 1 / (Gamma gamma))
   // Pixels covered by >= 2 UV triangles / pixels covered by >= 1; torn triangles
   // are not drawn (they span the cut and would cover the chart they cross).
   double overlap_ratio = 0;
   double seam_length = 0;         // 3D length of edges shared in 3D but not in UV
   Index charts = 0;               // components of faces joined through shared UV edges
   Index charts_without_torn = 0;  // the same with the torn faces left out
+  // Sum of |UV triangle areas| (unscaled) / area of the box holding the UVs and
+  // [0, 1]^2: the share of a unit-square texture the map uses.
+  double packing_efficiency = 0;
 };
 
 // positions: V x 3; faces: F x 3 indices into positions; uv: U x 2; uv_faces:
