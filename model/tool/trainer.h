@@ -15,6 +15,7 @@
 #include "engine/adam.h"
 #include "model/objective.h"
 #include "model/heuristics/wrap.h"
+#include "model/tool/team.h"
 
 namespace jsa {
 
@@ -109,7 +110,10 @@ class Trainer {
   // pools: per shape, P x 6 rows [x_S, n_S] in the shape's unit frame, n_S unit
   // length (scaled by alpha here). Drawn once; each step takes M rows of each.
   // More than one pool makes a collection: options.atlas.shapes is set to their count.
-  Trainer(const FitOptions& options, const std::vector<Block<double>>& pools);
+  // team: a data-parallel run (model/tool/team.h, docs/mpi.md); this rank trains
+  // the shapes of its block, and only their pools are needed (the others may be
+  // empty). The team must outlive the trainer; null: one process.
+  Trainer(const FitOptions& options, const std::vector<Block<double>>& pools, Team* team = nullptr);
   Trainer(const FitOptions& options, const Block<double>& pool)
       : Trainer(options, std::vector<Block<double>>{pool}) {}
   // One iteration. A NaN or Inf in the loss or the gradient is caught before
@@ -140,20 +144,32 @@ class Trainer {
   // The full state (parameters, Adam, RNG, iteration), for checkpoints.
   void save_state(std::ostream& out) const;
   void load_state(std::istream& in, const std::string& what);
+  // Every rank: brings the codes of every shape (values and Adam's moments) from
+  // the rank that trains them to all ranks, so that rank 0 can save or use the
+  // whole atlas. A collective call; nothing to do in one process.
+  void gather_codes();
+  // The shapes [first, last) this rank trains (all of them in one process).
+  std::pair<int, int> shape_block() const { return {first_shape_, last_shape_}; }
   Tape<float>& tape() { return tape_; }
 
  private:
   FitOptions options_;
-  std::vector<Block<float>> pools_;  // per shape P x 6, normals scaled by alpha
-  std::vector<NearestIndex<float>> surfaces_;  // per shape, over its pool (dense L_6D only)
+  std::vector<Block<float>> pools_;  // per shape P x 6, normals scaled by alpha (this rank's shapes only)
+  std::vector<NearestIndex<float>> surfaces_;  // per shape of the block, over its pool (dense L_6D only)
+  Team* team_ = nullptr;
+  int first_shape_ = 0, last_shape_ = 0;  // this rank's block of shapes
+  std::vector<std::pair<size_t, size_t>> shared_;  // (offset, length) of the parameters every rank trains
+  std::vector<float> exchange_;                    // their gradients, packed for the team's sum
   std::unique_ptr<Atlas<float>> atlas_;
   Adam<float> adam_;
   Tape<float> tape_;
   Rng rng_;
   int64_t iteration_ = 0;
   LossTerms last_;
-  std::vector<Block<float>> targets_;  // per shape of the step's batch
-  std::vector<int> batch_;             // the shapes of the step (all N without batching)
+  std::vector<Block<float>> targets_;  // per shape of local_
+  std::vector<int> batch_;             // the shapes of the step (all N without batching), on every rank
+  std::vector<int> local_;             // those of this rank's block
+  std::vector<Rng> shape_rngs_;        // per shape of local_: its draws this step
   // The last good state, refreshed every kSnapshotEvery iterations.
   static constexpr int64_t kSnapshotEvery = 50;
   std::vector<float> good_params_, good_m_, good_v_;
@@ -166,6 +182,7 @@ class Trainer {
   int reseeded_ = 0;
   bool wrapped_ = false;
   void take_snapshot();
+  bool exchange(LossTerms& sums, bool finite);
   void choose_orientation();
   void reseed();
 };
