@@ -23,8 +23,10 @@ Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools, T
   if (ranks > n)
     throw InputError(std::to_string(ranks) + " MPI ranks for " + std::to_string(n) +
                      " shapes: run at most one rank per shape");
-  if (ranks > 1 && o.wrap_steps > 0) throw InputError("--wrap is not supported with more than one MPI rank");
-  if (ranks > 1 && o.reseed_every > 0) throw InputError("--reseed is not supported with more than one MPI rank");
+  if (ranks > 1 && o.wrap_steps > 0)
+    throw InputError("--wrap is not supported with more than one MPI rank");
+  if (ranks > 1 && o.reseed_every > 0)
+    throw InputError("--reseed is not supported with more than one MPI rank");
   std::tie(first_shape_, last_shape_) = jsa::shape_block(n, ranks, team ? team->rank() : 0);
   for (int i = 0; i < n; ++i) {
     const Block<double>& pool = pools[size_t(i)];
@@ -36,7 +38,8 @@ Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools, T
     pools_.push_back(pool.cast<float>());
     pools_.back().rightCols(3) *= float(o.atlas.alpha);
     if (o.dense_surface)
-      surfaces_.emplace_back(o.components.normals ? pools_.back() : Block<float>(pools_.back().leftCols(3)));
+      surfaces_.emplace_back(o.components.normals ? pools_.back()
+                                                  : Block<float>(pools_.back().leftCols(3)));
   }
   const int b = o.batch_shapes > 0 && o.batch_shapes < n ? o.batch_shapes : n;
   if (o.batch_shapes < 0) throw InputError("--batch-shapes must be >= 0");
@@ -58,7 +61,8 @@ Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools, T
 
 double Trainer::learning_rate() const {
   std::vector<int64_t> milestones;
-  for (double f : options_.decay_at) milestones.push_back(int64_t(std::llround(f * double(options_.iterations))));
+  for (double f : options_.decay_at)
+    milestones.push_back(int64_t(std::llround(f * double(options_.iterations))));
   return lr_scale_ * step_decay(options_.lr, iteration_, milestones, options_.decay);
 }
 
@@ -73,7 +77,8 @@ WrapReport Trainer::wrap(const std::function<bool()>& cancelled) {
   if (wrapped_ || iteration_ > 0 || options_.wrap_steps <= 0) return {};
   wrapped_ = true;
   Rng rng(options_.seed, 2);  // its own stream: the training draws are the same with or without it
-  return wrap_initialize(*atlas_, pools_, options_.wrap_steps, options_.points, options_.lr, rng, cancelled);
+  return wrap_initialize(*atlas_, pools_, options_.wrap_steps, options_.points, options_.lr, rng,
+                         cancelled);
 }
 
 void Trainer::step() {
@@ -84,7 +89,8 @@ void Trainer::step() {
     // (the same on every rank: rng_ is).
     std::vector<int> order(static_cast<size_t>(n));
     for (int i = 0; i < n; ++i) order[size_t(i)] = i;
-    for (int i = 0; i < b; ++i) std::swap(order[size_t(i)], order[size_t(i) + rng_.below(uint64_t(n - i))]);
+    for (int i = 0; i < b; ++i)
+      std::swap(order[size_t(i)], order[size_t(i) + rng_.below(uint64_t(n - i))]);
     batch_.assign(order.begin(), order.begin() + b);
   }
   // Each shape draws its targets and its x_P from a generator of its own, seeded
@@ -107,12 +113,14 @@ void Trainer::step() {
   for (size_t k = 0; k < local_.size(); ++k) {
     const Block<float>& pool = pools_[size_t(local_[k])];
     Rng& rng = shape_rngs_[k];
-    for (Index m = 0; m < options_.points; ++m) targets_[k].row(m) = pool.row(Index(rng.below(uint64_t(pool.rows()))));
+    for (Index m = 0; m < options_.points; ++m)
+      targets_[k].row(m) = pool.row(Index(rng.below(uint64_t(pool.rows()))));
     share.rngs.push_back(&rng);
     if (!surfaces_.empty()) share.surfaces.push_back(&surfaces_[size_t(local_[k] - first_shape_)]);
   }
   tape_.clear();
-  const ObjectiveOptions objective{options_.weights, options_.components, options_.repulsion_tolerance};
+  const ObjectiveOptions objective{options_.weights, options_.components,
+                                   options_.repulsion_tolerance};
   LossTerms sums;
   Var loss = objective_share(tape_, *atlas_, targets_, options_.points, objective, share, &sums);
   atlas_->params.zero_grad();
@@ -125,7 +133,9 @@ void Trainer::step() {
   for (float g : atlas_->params.grads()) finite = finite && std::isfinite(g);
   if (team_ && team_->size() > 1) finite = exchange(sums, finite);
   last_ = sums;
-  for (double* v : {&last_.surface, &last_.chart, &last_.cycle_2d, &last_.cycle_6d, &last_.isometry}) *v /= b;
+  for (double* v :
+       {&last_.surface, &last_.chart, &last_.cycle_2d, &last_.cycle_6d, &last_.isometry})
+    *v /= b;
   if (!finite) {
     // Back to the last good state with half the step; this batch is skipped.
     ++faults_total_;
@@ -152,18 +162,20 @@ void Trainer::step() {
 // terms, whether every rank's loss and gradient were finite, and the gradient of
 // the shared parameters. The codes' gradients stay on the rank of their shape.
 bool Trainer::exchange(LossTerms& sums, bool finite) {
-  double terms[8] = {sums.total, sums.surface, sums.chart, sums.cycle_2d, sums.cycle_6d,
-                     sums.isometry, sums.repulsion, finite ? 0.0 : 1.0};
+  double terms[8] = {sums.total,    sums.surface,  sums.chart,     sums.cycle_2d,
+                     sums.cycle_6d, sums.isometry, sums.repulsion, finite ? 0.0 : 1.0};
   team_->sum_in_rank_order(terms, 8);
   sums = LossTerms{terms[0], terms[1], terms[2], terms[3], terms[4], terms[5], terms[6]};
   if (terms[7] != 0 || !std::isfinite(sums.total)) return false;
   std::vector<float>& grads = atlas_->params.grads();
   exchange_.clear();
-  for (const auto& [offset, length] : shared_) exchange_.insert(exchange_.end(), &grads[offset], &grads[offset] + length);
+  for (const auto& [offset, length] : shared_)
+    exchange_.insert(exchange_.end(), &grads[offset], &grads[offset] + length);
   team_->sum_in_rank_order(exchange_.data(), exchange_.size());
   size_t at = 0;
   for (const auto& [offset, length] : shared_) {
-    std::copy(exchange_.begin() + std::ptrdiff_t(at), exchange_.begin() + std::ptrdiff_t(at + length), &grads[offset]);
+    std::copy(exchange_.begin() + std::ptrdiff_t(at),
+              exchange_.begin() + std::ptrdiff_t(at + length), &grads[offset]);
     at += length;
   }
   return true;
@@ -180,7 +192,8 @@ void Trainer::gather_codes() {
       const auto& entry = p.entry(p.find(name));
       float* codes = buffer->data() + entry.offset;
       for (int s = 0; s < atlas_->shapes(); ++s)
-        if (s < first_shape_ || s >= last_shape_) std::fill(codes + size_t(s) * d, codes + size_t(s + 1) * d, 0.0f);
+        if (s < first_shape_ || s >= last_shape_)
+          std::fill(codes + size_t(s) * d, codes + size_t(s + 1) * d, 0.0f);
       team_->sum_in_rank_order(codes, size_t(entry.rows) * d);
     }
   }
@@ -197,7 +210,8 @@ void Trainer::choose_orientation() {
   double back = 0;
   for (size_t i = 0; i < targets_.size(); ++i) {
     Rng rng = check.stream(uint64_t(local_[i]));
-    back += back_facing_fraction(*atlas_, targets_[i], std::min<Index>(options_.points, 2000), rng, local_[i]);
+    back += back_facing_fraction(*atlas_, targets_[i], std::min<Index>(options_.points, 2000), rng,
+                                 local_[i]);
   }
   if (team_ && team_->size() > 1) team_->sum_in_rank_order(&back, 1);
   if (back / double(batch_.size()) <= 0.5) return;
@@ -223,8 +237,8 @@ void Trainer::reseed() {
     for (Index m = 0; m < count; ++m) t.row(m) = pool.row(Index(rng.below(uint64_t(pool.rows()))));
     targets.push_back(std::move(t));
   }
-  const ReseedReport r =
-      reseed_flipped_means(*atlas_, targets, batch_, rng, {&adam_.first_moment(), &adam_.second_moment()});
+  const ReseedReport r = reseed_flipped_means(*atlas_, targets, batch_, rng,
+                                              {&adam_.first_moment(), &adam_.second_moment()});
   if (r.flipped == 0) return;
   reseeded_ += r.flipped;
   take_snapshot();
@@ -233,7 +247,9 @@ void Trainer::reseed() {
 // Layout: i64 iteration, 4 x u64 RNG state, i64 Adam steps, f64 lr scale, parameters,
 // then Adam's two moment vectors (u64 length + floats each).
 void Trainer::save_state(std::ostream& out) const {
-  auto put = [&](const void* p, size_t n) { out.write(static_cast<const char*>(p), std::streamsize(n)); };
+  auto put = [&](const void* p, size_t n) {
+    out.write(static_cast<const char*>(p), std::streamsize(n));
+  };
   put(&iteration_, sizeof iteration_);
   const auto s = rng_.state();
   put(s.data(), sizeof(uint64_t) * 4);
@@ -265,7 +281,8 @@ void Trainer::load_state(std::istream& in, const std::string& what) {
   for (std::vector<float>* v : {&adam_.first_moment(), &adam_.second_moment()}) {
     uint64_t n = 0;
     get(&n, sizeof n);
-    if (n != 0 && n != atlas_->params.size()) throw InputError(what + ": Adam state does not match the model");
+    if (n != 0 && n != atlas_->params.size())
+      throw InputError(what + ": Adam state does not match the model");
     v->resize(n);
     get(v->data(), sizeof(float) * n);
   }

@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "engine/adam.h"
-#include "model/objective.h"
 #include "model/heuristics/wrap.h"
+#include "model/objective.h"
 #include "model/tool/team.h"
 
 namespace jsa {
@@ -39,19 +39,19 @@ struct FitOptions {
     // input out with fewer flipped triangles (docs/method.md, "lambda_cycle").
     weights.cycle = 0.1;
   }
-  AtlasOptions atlas;          // K, network sizes, alpha
-  LossWeights weights;         // the lambdas of Eq. 5 (mean convention)
-  Components components;       // ablation switches (default: full method, row 11)
-  int64_t iterations = 5000;   // Adam steps
-  Index points = 2500;         // M: points sampled on P and on the shape per step
-  double lr = 1e-3;            // Adam learning rate
+  AtlasOptions atlas;                          // K, network sizes, alpha
+  LossWeights weights;                         // the lambdas of Eq. 5 (mean convention)
+  Components components;                       // ablation switches (default: full method, row 11)
+  int64_t iterations = 5000;                   // Adam steps
+  Index points = 2500;                         // M: points sampled on P and on the shape per step
+  double lr = 1e-3;                            // Adam learning rate
   std::vector<double> decay_at = {0.75, 0.9};  // fractions of `iterations` where lr *= decay
-  double decay = 0.1;          // step-decay factor
-  uint64_t seed = 1;           // every random draw derives from it
-  double repulsion_tolerance = 1e-7;  // cut-off error bound of L_rep
-  int max_faults = 5;          // NaN/Inf recoveries in a row before giving up
-  Index pool = 200000;         // surface samples drawn once per shape (the targets' pool)
-  int threads = 0;             // threads of the run (0: all); results depend on seed and threads
+  double decay = 0.1;                          // step-decay factor
+  uint64_t seed = 1;                           // every random draw derives from it
+  double repulsion_tolerance = 1e-7;           // cut-off error bound of L_rep
+  int max_faults = 5;                          // NaN/Inf recoveries in a row before giving up
+  Index pool = 200000;  // surface samples drawn once per shape (the targets' pool)
+  int threads = 0;      // threads of the run (0: all); results depend on seed and threads
   // Every this many iterations before the first decay point, choose the global
   // orientation of phi (model/heuristics/orientation.h); 0: never. Only with normals in the loss.
   int orient_every = 100;
@@ -102,7 +102,8 @@ struct NumericalFault : std::runtime_error {
   using std::runtime_error::runtime_error;
   NumericalFault(int faults_in_a_row, int64_t iteration)
       : std::runtime_error("training diverged: NaN/Inf " + std::to_string(faults_in_a_row) +
-                           " times in a row at iteration " + std::to_string(iteration) + " (try a smaller --lr)") {}
+                           " times in a row at iteration " + std::to_string(iteration) +
+                           " (try a smaller --lr)") {}
 };
 
 class Trainer {
@@ -126,7 +127,9 @@ class Trainer {
   WrapReport wrap(const std::function<bool()>& cancelled = {});
   double learning_rate() const;  // the schedule at the current iteration, times the fault scale
   int faults() const { return faults_total_; }
-  int mirrors() const { return mirrors_; }  // times the domain was mirrored (model/heuristics/orientation.h)
+  int mirrors() const {
+    return mirrors_;
+  }  // times the domain was mirrored (model/heuristics/orientation.h)
   int reseeded() const { return reseeded_; }  // Gaussians moved so far (model/heuristics/reseed.h)
   // Test hook: the next `count` attempts at `iteration` see a NaN loss.
   void inject_faults(int64_t iteration, int count) {
@@ -154,12 +157,15 @@ class Trainer {
 
  private:
   FitOptions options_;
-  std::vector<Block<float>> pools_;  // per shape P x 6, normals scaled by alpha (this rank's shapes only)
-  std::vector<NearestIndex<float>> surfaces_;  // per shape of the block, over its pool (dense L_6D only)
+  std::vector<Block<float>>
+      pools_;  // per shape P x 6, normals scaled by alpha (this rank's shapes only)
+  std::vector<NearestIndex<float>>
+      surfaces_;  // per shape of the block, over its pool (dense L_6D only)
   Team* team_ = nullptr;
   int first_shape_ = 0, last_shape_ = 0;  // this rank's block of shapes
-  std::vector<std::pair<size_t, size_t>> shared_;  // (offset, length) of the parameters every rank trains
-  std::vector<float> exchange_;                    // their gradients, packed for the team's sum
+  std::vector<std::pair<size_t, size_t>>
+      shared_;                   // (offset, length) of the parameters every rank trains
+  std::vector<float> exchange_;  // their gradients, packed for the team's sum
   std::unique_ptr<Atlas<float>> atlas_;
   Adam<float> adam_;
   Tape<float> tape_;
@@ -167,9 +173,9 @@ class Trainer {
   int64_t iteration_ = 0;
   LossTerms last_;
   std::vector<Block<float>> targets_;  // per shape of local_
-  std::vector<int> batch_;             // the shapes of the step (all N without batching), on every rank
-  std::vector<int> local_;             // those of this rank's block
-  std::vector<Rng> shape_rngs_;        // per shape of local_: its draws this step
+  std::vector<int> batch_;       // the shapes of the step (all N without batching), on every rank
+  std::vector<int> local_;       // those of this rank's block
+  std::vector<Rng> shape_rngs_;  // per shape of local_: its draws this step
   // The last good state, refreshed every kSnapshotEvery iterations.
   static constexpr int64_t kSnapshotEvery = 50;
   std::vector<float> good_params_, good_m_, good_v_;

@@ -17,11 +17,13 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    const jsa::CheckpointContents ca = jsa::read_checkpoint(argv[1]), cb = jsa::read_checkpoint(argv[2]);
+    const jsa::CheckpointContents ca = jsa::read_checkpoint(argv[1]),
+                                  cb = jsa::read_checkpoint(argv[2]);
     const auto a = jsa::load_atlas(ca, argv[1]), b = jsa::load_atlas(cb, argv[2]);
     const std::vector<float>&va = a->params.values(), &vb = b->params.values();
     if (va.size() != vb.size()) {
-      std::fprintf(stderr, "compare_checkpoints: %zu against %zu parameters\n", va.size(), vb.size());
+      std::fprintf(stderr, "compare_checkpoints: %zu against %zu parameters\n", va.size(),
+                   vb.size());
       return 1;
     }
     double worst = 0, scale = 0;
@@ -35,11 +37,13 @@ int main(int argc, char** argv) {
     std::string where;
     for (int e = 0; e < a->params.count(); ++e) {
       const auto& entry = a->params.entry(e);
-      if (at >= entry.offset && at < entry.offset + size_t(entry.rows * entry.cols)) where = entry.name;
+      if (at >= entry.offset && at < entry.offset + size_t(entry.rows * entry.cols))
+        where = entry.name;
     }
     const double rel = worst / std::max(scale, 1e-30);
-    std::printf("%zu parameters, %zu differ; max |a - b| = %.3e (in %s), max |a| = %.3e, rel = %.3e\n", va.size(),
-                differ, worst, where.c_str(), scale, rel);
+    std::printf(
+        "%zu parameters, %zu differ; max |a - b| = %.3e (in %s), max |a| = %.3e, rel = %.3e\n",
+        va.size(), differ, worst, where.c_str(), scale, rel);
     if (argc == 3) return differ == 0 ? 0 : 1;
     return rel <= std::atof(argv[3]) ? 0 : 1;
   } catch (const std::exception& e) {

@@ -25,9 +25,13 @@ namespace {
 template <class T>
 MPI_Datatype mpi_type();
 template <>
-MPI_Datatype mpi_type<float>() { return MPI_FLOAT; }
+MPI_Datatype mpi_type<float>() {
+  return MPI_FLOAT;
+}
 template <>
-MPI_Datatype mpi_type<double>() { return MPI_DOUBLE; }
+MPI_Datatype mpi_type<double>() {
+  return MPI_DOUBLE;
+}
 
 class MpiTeam : public Team {
  public:
@@ -79,8 +83,9 @@ class MpiTeam : public Team {
       mine_first[r] = int(r) * mine;
     }
     std::vector<T> pieces(p * size_t(mine));
-    JSA_CHECK(MPI_Alltoallv(data, count.data(), first.data(), mpi_type<T>(), pieces.data(), mine_count.data(),
-                            mine_first.data(), mpi_type<T>(), MPI_COMM_WORLD) == MPI_SUCCESS,
+    JSA_CHECK(MPI_Alltoallv(data, count.data(), first.data(), mpi_type<T>(), pieces.data(),
+                            mine_count.data(), mine_first.data(), mpi_type<T>(),
+                            MPI_COMM_WORLD) == MPI_SUCCESS,
               "MPI_Alltoallv failed");
     T* out = data + first[size_t(rank_)];
     for (int i = 0; i < mine; ++i) {
@@ -88,8 +93,8 @@ class MpiTeam : public Team {
       for (size_t r = 1; r < p; ++r) s += pieces[r * size_t(mine) + size_t(i)];
       out[i] = s;
     }
-    JSA_CHECK(MPI_Allgatherv(MPI_IN_PLACE, 0, mpi_type<T>(), data, count.data(), first.data(), mpi_type<T>(),
-                             MPI_COMM_WORLD) == MPI_SUCCESS,
+    JSA_CHECK(MPI_Allgatherv(MPI_IN_PLACE, 0, mpi_type<T>(), data, count.data(), first.data(),
+                             mpi_type<T>(), MPI_COMM_WORLD) == MPI_SUCCESS,
               "MPI_Allgatherv failed");
     // Payload only: what leaves and what reaches this rank in the two collectives.
     const uint64_t others = uint64_t(n) - uint64_t(mine);
@@ -115,7 +120,9 @@ void abort_mpi_job(int code) {
 bool mpi_available() { return false; }
 
 std::unique_ptr<Team> join_mpi_team() {
-  throw InputError("this jsatlas was built without MPI: rebuild with OpenMPI installed (cmake -DJSATLAS_MPI=ON)");
+  throw InputError(
+      "this jsatlas was built without MPI: rebuild with OpenMPI installed (cmake "
+      "-DJSATLAS_MPI=ON)");
 }
 
 void abort_mpi_job(int code) { std::exit(code); }
