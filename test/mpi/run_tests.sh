@@ -6,6 +6,7 @@
 #   determinism  mpirun -np 2 a second time: bit-identical to np2's checkpoint
 #   resume       -np 2 stopped at iteration 6, resumed with -np 3: within BOUND
 #   batch        --batch-shapes 3 on 1 process and on 2 ranks: within BOUND
+#   errors       more ranks than shapes, --wrap over 2 ranks: a one-line error, the job ends non-zero
 # Usage: run_tests.sh MODE JSATLAS COMPARE MPIEXEC WORKDIR BOUND
 set -euo pipefail
 mode=$1 jsatlas=$2 compare=$3 mpiexec=$4 work=$5 bound=$6
@@ -49,5 +50,13 @@ case "$mode" in
   batch)
     rm -rf np2_batch && run 2 "${fit[@]}" --batch-shapes 3 -o np2_batch
     "$compare" one_batch/model.ckpt np2_batch/model.ckpt "$bound" ;;
+  errors)
+    expect_error() {  # expect_error MESSAGE NP ARGS...: the job fails and names the reason
+      local message=$1 np=$2; shift 2
+      if run "$np" "$@" > err.txt 2>&1; then echo "errors: '$*' on $np ranks succeeded"; exit 1; fi
+      grep -q -- "$message" err.txt || { echo "errors: no '$message' in:"; cat err.txt; exit 1; }
+    }
+    expect_error "2 MPI ranks for 1 shapes" 2 fit builtin:sphere -o too_many --iters 2 -q
+    expect_error "--wrap is not supported with more than one MPI rank" 2 "${fit[@]}" --wrap 5 -o wrapped ;;
   *) echo "run_tests.sh: unknown mode $mode"; exit 2 ;;
 esac
