@@ -9,7 +9,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "model/checkpoint.h"
+#include "model/tool/checkpoint.h"
 
 int main(int argc, char** argv) {
   if (argc != 3 && argc != 4) {
