@@ -1,11 +1,14 @@
 // `jsatlas fit INPUT -o DIR`: learn the atlas of one shape (paper Sec. 3).
 // Writes DIR/config.json, DIR/losses.csv, DIR/model.ckpt (every
 // --checkpoint-every iterations and at the end) and DIR/domain_mesh.obj.
+// Under `mpirun -np P` a collection's shapes are split over P ranks
+// (docs/mpi.md); rank 0 prints and writes every file.
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -20,6 +23,7 @@
 #include "io/pictures/image.h"
 #include "model/tool/checkpoint.h"
 #include "model/tool/fit_config.h"
+#include "model/tool/mpi/mpi_team.h"
 
 namespace jsa::cli {
 namespace {
@@ -40,7 +44,8 @@ struct FitArgs {
   int mesh_resolution = 256;
   double mesh_threshold = 0.05;
   std::string texture;
-  double minutes = 0;  // > 0: size --iters to this wall-time budget
+  double minutes = 0;   // > 0: size --iters to this wall-time budget
+  int64_t stop_at = 0;  // > 0: stop after this iteration with a checkpoint (continue with --resume)
   bool quiet = false;
   int64_t inject_fault_at = -1;  // tests only: one NaN loss at this iteration
 };
@@ -56,7 +61,7 @@ std::string format_duration(double seconds) {
 }
 
 // The library names settings (FitOptions' fields); the user knows the flags.
-Trainer make_trainer(const FitOptions& o, const std::vector<Block<double>>& pools) {
+Trainer make_trainer(const FitOptions& o, const std::vector<Block<double>>& pools, Team* team) {
   static const std::pair<const char*, const char*> kFlags[] = {
       {"points", "--points"},
       {"iterations", "--iters"},
@@ -71,9 +76,11 @@ Trainer make_trainer(const FitOptions& o, const std::vector<Block<double>>& pool
       {"weights.isometry", "--w-iso"},
       {"weights.repulsion", "--w-rep"},
       {"weights.code", "--w-code"},
-      {"repulsion_tolerance", "--repulsion-tolerance"}};
+      {"repulsion_tolerance", "--repulsion-tolerance"},
+      {"wrap_steps", "--wrap"},
+      {"reseed_every", "--reseed"}};
   try {
-    return Trainer(o, pools);
+    return Trainer(o, pools, team);
   } catch (const InputError& e) {
     const std::string m = e.what();
     for (const auto& [setting, flag] : kFlags)
@@ -83,8 +90,26 @@ Trainer make_trainer(const FitOptions& o, const std::vector<Block<double>>& pool
   }
 }
 
-void run_fit(FitArgs& a) {
+// The processes of this run: the MPI job when an MPI launcher started us, else one.
+std::unique_ptr<Team> join_team() {
+  if (!launched_by_mpi()) return std::make_unique<Team>();
+  if (!mpi_available()) {
+    for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"}) {
+      const char* size = std::getenv(name);
+      if (size && std::string(size) != "1")
+        throw InputError("fit: started by an MPI launcher with " + std::string(size) +
+                         " processes, but this jsatlas was built without MPI (install "
+                         "libopenmpi-dev and rebuild)");
+    }
+    return std::make_unique<Team>();
+  }
+  return join_mpi_team();
+}
+
+void run_fit(FitArgs& a, Team& team) {
   namespace fs = std::filesystem;
+  const bool root = team.rank() == 0, many = team.size() > 1;
+  if (!root) a.quiet = true;  // rank 0 speaks for the job
   FitOptions o = a.options;
   std::vector<std::string> inputs = a.inputs;
   if (!a.list_file.empty()) {
@@ -127,22 +152,34 @@ void run_fit(FitArgs& a) {
     (void)read_image(a.texture);  // a bad texture fails now, not after training
 
   // Each shape, a fixed pool of surface samples, and its unit frame (Sec. 4 data).
+  // Over MPI each rank samples the pools of its own block of shapes; rank 0 also
+  // reads the others' inputs (their frames for the checkpoint, their meshes for
+  // the outputs) but keeps no pool of theirs.
+  const auto [block_first, block_last] = shape_block(int(inputs.size()), team.size(), team.rank());
   std::vector<RunInput> shapes;
   std::vector<Block<double>> pools;
   std::vector<Normalization> frames;
   for (size_t i = 0; i < inputs.size(); ++i) {
+    const bool mine = int(i) >= block_first && int(i) < block_last;
+    if (!mine && !root) {
+      shapes.emplace_back();
+      pools.emplace_back(0, 6);
+      frames.emplace_back();
+      continue;
+    }
     shapes.push_back(load_run_input(inputs[i], o.pool, o.seed + 1000 * i));
     if (resuming) shapes.back().normalization = resumed.normalizations[i];
-    pools.push_back(shapes.back().pool);
+    pools.push_back(mine ? shapes.back().pool : Block<double>(0, 6));
+    shapes.back().pool.resize(0, 6);
     frames.push_back(shapes.back().normalization);
     for (const std::string& w : shapes.back().mesh.warnings)
-      if (!a.quiet) std::cerr << "warning: " << inputs[i] << ": " << w << "\n";
+      if (mine && !(a.quiet && root)) std::cerr << "warning: " << inputs[i] << ": " << w << "\n";
   }
   o.atlas.shapes = int(inputs.size());
-  fs::create_directories(a.out_dir);
+  if (root) fs::create_directories(a.out_dir);
   const std::string dir = a.out_dir;
 
-  Trainer trainer = make_trainer(o, pools);
+  Trainer trainer = make_trainer(o, pools, &team);
   LossLog log;
   if (resuming) {
     restore_trainer(trainer, resumed, a.resume);
@@ -154,12 +191,15 @@ void run_fit(FitArgs& a) {
               << " -> " << dir << "  (" << o.iterations << " iterations, M = " << o.points
               << ", K = " << o.atlas.gaussians << ", MLP " << o.atlas.hidden_layers << "x"
               << o.atlas.width << ", " << max_threads() << " threads"
+              << (many ? " on each of " + std::to_string(team.size()) + " MPI ranks"
+                       : std::string())
               << (resuming ? ", resumed at " + std::to_string(trainer.iteration()) : std::string())
               << ")\n";
 
   // config.json: the settings, and what the run has done so far (faults and
   // the action taken for each, mirrors, reseeds).
   auto write_config = [&]() {
+    if (!root) return;
     write_file_atomically(dir + "/config.json", [&](std::ostream& out) {
       out << "{\n\"inputs\": [";
       for (size_t i = 0; i < inputs.size(); ++i) out << (i ? ", " : "") << json_quote(inputs[i]);
@@ -173,10 +213,21 @@ void run_fit(FitArgs& a) {
     });
   };
   write_config();
+  // Every rank calls save() at the same iteration: the codes are gathered from
+  // their ranks (a collective), then rank 0 writes.
   auto save = [&]() {
+    trainer.gather_codes();
+    if (!root) return;
     write_config();
     write_checkpoint(dir + "/model.ckpt", inputs, o, frames, trainer);
     write_loss_log(dir + "/losses.csv", log);
+  };
+  // What every rank must decide alike is decided by rank 0's value (the others add 0).
+  auto rank0_value = [&](double v) {
+    if (!many) return v;
+    double x = root ? v : 0.0;
+    team.sum_in_rank_order(&x, 1);
+    return x;
   };
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
@@ -205,8 +256,11 @@ void run_fit(FitArgs& a) {
     record_step(log, r);
     advanced = !r.fault;
     if (r.fault) {  // printed even with --quiet: the run's result depends on it
-      std::fprintf(stderr, "  it %6lld: %s\n", (long long)r.fault->iteration,
-                   describe(*r.fault).c_str());
+      // Every rank takes the same recovery (the NaN flag is summed over the
+      // team): rank 0 speaks for the job.
+      if (root)
+        std::fprintf(stderr, "  it %6lld: %s\n", (long long)r.fault->iteration,
+                     describe(*r.fault).c_str());
       return;
     }
     if (a.quiet) return;
@@ -246,7 +300,8 @@ void run_fit(FitArgs& a) {
       const double per = std::chrono::duration<double>(now - probe_start).count() / double(probe);
       const double left =
           a.minutes * 60.0 - wrap_seconds - std::chrono::duration<double>(now - start).count();
-      const int64_t n = warmup + probe + std::max<int64_t>(1, int64_t(left / per * 0.97));
+      const int64_t n = int64_t(
+          rank0_value(double(warmup + probe + std::max<int64_t>(1, int64_t(left / per * 0.97)))));
       trainer.set_iterations(n);
       o.iterations = n;
       sized = true;
@@ -263,20 +318,36 @@ void run_fit(FitArgs& a) {
                        "/model.ckpt");
     }
     if (advanced && a.checkpoint_every > 0 && trainer.iteration() % a.checkpoint_every == 0) save();
-    if (g_signal) {
+    // A signal reaches the ranks at different steps: stop when any rank has one.
+    double signalled = g_signal != 0 ? 1.0 : 0.0;
+    if (many) team.sum_in_rank_order(&signalled, 1);
+    if (advanced && a.stop_at > 0 && trainer.iteration() == a.stop_at && !trainer.finished()) {
+      save();
+      if (!a.quiet)
+        std::cerr << "fit: stopped at iteration " << trainer.iteration()
+                  << " (--stop-at); continue with: jsatlas fit --resume " << dir << "\n";
+      return;
+    }
+    if (signalled > 0) {
       save();
       std::cerr << "fit: interrupted; checkpoint written at iteration " << trainer.iteration()
                 << " (continue with: jsatlas fit --resume " << dir << ")\n";
       throw ExitCode{130};
     }
   }
+  const double seconds = std::chrono::duration<double>(clock::now() - start).count();
+  const uint64_t bytes = team.bytes_exchanged();
   save();
+  if (!root) return;
   write_run_outputs(trainer.atlas(), shapes, log, dir,
                     MeshOutputOptions{a.mesh_resolution, a.mesh_threshold, a.quiet, a.texture});
-  if (!a.quiet)
-    std::cerr << "fit: done in "
-              << format_duration(std::chrono::duration<double>(clock::now() - start).count())
-              << "; results in " << dir << "\n";
+  if (!a.quiet) {
+    const int64_t steps = std::max<int64_t>(1, trainer.iteration() - first);
+    std::cerr << "fit: done in " << format_duration(seconds) << " ("
+              << seconds * 1e3 / double(steps) << " ms/iteration";
+    if (many) std::cerr << ", rank 0 exchanged " << bytes / uint64_t(steps) << " bytes/iteration";
+    std::cerr << "); results in " << dir << "\n";
+  }
   // The report (stdout): what the run did beyond plain Adam steps.
   std::cout << "fit: " << trainer.iteration() << " iterations, " << trainer.faults()
             << " NaN/Inf fault" << (trainer.faults() == 1 ? "" : "s") << ", " << trainer.mirrors()
@@ -356,6 +427,10 @@ void add_fit(CLI::App& app) {
                 "Time budget: after 5 warm-up and 20 timed iterations, set --iters to fill it (the "
                 "schedule follows)")
       ->check(CLI::Range(0.01, 100000.0));
+  c->add_option("--stop-at", a->stop_at,
+                "Stop after this iteration with a checkpoint, exit 0; continue with --resume (job "
+                "time limits; the schedule is --iters')")
+      ->check(CLI::Range(int64_t(1), int64_t(100000000)));
   c->add_option("--seed", o.seed, "Random seed (same seed and threads -> same run)")
       ->capture_default_str();
   c->add_option(
@@ -460,7 +535,22 @@ void add_fit(CLI::App& app) {
   // Hidden (no group): lets the CLI tests see a NaN/Inf recovery end to end.
   c->add_option("--inject-fault-at", a->inject_fault_at, "Tests: one NaN loss at this iteration")
       ->group("");
-  c->callback([a]() { run_fit(*a); });
+  c->callback([a]() {
+    std::unique_ptr<Team> team = join_team();
+    if (team->size() == 1) return run_fit(*a, *team);
+    try {
+      run_fit(*a, *team);
+    } catch (const ExitCode& e) {
+      if (e.code == 130)
+        throw;  // an interrupt all ranks agreed on: each leaves through MPI_Finalize
+      abort_mpi_job(e.code);
+    } catch (const std::exception& e) {
+      // Perhaps this rank alone (its input, its disk): the others would wait for it forever.
+      std::cerr << "jsatlas: error on MPI rank " << team->rank() << " of " << team->size() << ": "
+                << e.what() << "\n";
+      abort_mpi_job(1);
+    }
+  });
 }
 
 }  // namespace jsa::cli

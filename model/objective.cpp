@@ -60,7 +60,8 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
   // With `dense`, phi6(x_P) finds its match in the whole pool (losses/chamfer.h).
   const Var generated = c.normals ? first_m(all.phi6) : first_m(all.points);
   const Var sampled = c.normals ? s6 : slice_cols(t, s6, 0, 3);
-  const Var surface = dense ? chamfer(t, generated, sampled, *dense) : chamfer(t, generated, sampled);
+  const Var surface =
+      dense ? chamfer(t, generated, sampled, *dense) : chamfer(t, generated, sampled);
   weighted.push_back({w.surface, surface});
   out.surface = double(t.scalar(surface));
 
@@ -102,65 +103,113 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
 }
 
 template <class T>
-Var collection_objective(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>>& targets, Index m,
-                         Rng& rng, const ObjectiveOptions& o, LossTerms* terms, const std::vector<int>& batch,
-                         const std::vector<NearestIndex<T>>& surfaces) {
+Var objective_share(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>>& targets, Index m,
+                    const ObjectiveOptions& o, const ObjectiveShare<T>& share, LossTerms* terms) {
   const int n = atlas.shapes();
   const int b = int(targets.size());
-  if (batch.empty())
-    JSA_CHECK(b == n, targets.size() << " target sets for " << n << " shapes");
-  else
-    JSA_CHECK(b == int(batch.size()) && b > 0 && b <= n, targets.size() << " target sets for a batch of " << batch.size());
-  JSA_CHECK(surfaces.empty() || int(surfaces.size()) == n, surfaces.size() << " surface indexes for " << n << " shapes");
+  JSA_CHECK(int(share.shapes.size()) == b && int(share.rngs.size()) == b,
+            targets.size() << " target sets for " << share.shapes.size() << " shapes");
+  JSA_CHECK(share.batch >= b && share.batch <= n,
+            "a batch of " << share.batch << " of " << n << " shapes");
+  JSA_CHECK(share.surfaces.empty() || int(share.surfaces.size()) == b,
+            "one surface index per target set");
+  JSA_CHECK(share.code_begin >= 0 && share.code_end <= n,
+            "codes [" << share.code_begin << ", " << share.code_end << ")");
   ObjectiveOptions per_shape = o;
   per_shape.components.repulsion = false;
   LossTerms sum_terms, one;
   Var total;
   for (int k = 0; k < b; ++k) {
-    const int shape = batch.empty() ? k : batch[size_t(k)];
+    const int shape = share.shapes[size_t(k)];
     JSA_CHECK(shape >= 0 && shape < n, "shape " << shape << " of " << n);
-    const NearestIndex<T>* dense = surfaces.empty() ? nullptr : &surfaces[size_t(shape)];
-    const Var l = single_shape_objective(t, atlas, shape, targets[size_t(k)], m, rng, per_shape, &one, dense);
+    const NearestIndex<T>* dense = share.surfaces.empty() ? nullptr : share.surfaces[size_t(k)];
+    const Var l = single_shape_objective(t, atlas, shape, targets[size_t(k)], m,
+                                         *share.rngs[size_t(k)], per_shape, &one, dense);
     total = k == 0 ? l : add(t, total, l);
-    sum_terms.surface += one.surface / b;
-    sum_terms.chart += one.chart / b;
-    sum_terms.cycle_2d += one.cycle_2d / b;
-    sum_terms.cycle_6d += one.cycle_6d / b;
-    sum_terms.isometry += one.isometry / b;
+    sum_terms.surface += one.surface;
+    sum_terms.chart += one.chart;
+    sum_terms.cycle_2d += one.cycle_2d;
+    sum_terms.cycle_6d += one.cycle_6d;
+    sum_terms.isometry += one.isometry;
   }
-  if (b < n) total = scale(t, total, T(double(n) / double(b)));
+  // A subset of B shapes stands for all N: its sum is scaled by N / B (see collection_objective).
+  if (b > 0 && share.batch < n) total = scale(t, total, T(double(n) / double(share.batch)));
   if (!std::isfinite(sum_terms.surface) || !atlas.params.value(atlas.domain.means()).allFinite()) {
     // A diverged step (see single_shape_objective): NaN for the trainer to catch.
     sum_terms.total = std::numeric_limits<double>::quiet_NaN();
     if (terms) *terms = sum_terms;
     return t.constant(Block<T>::Constant(1, 1, std::numeric_limits<T>::quiet_NaN()));
   }
-  if (o.components.repulsion) {
+  auto plus = [&](Var v) { total = total.valid() ? add(t, total, v) : v; };
+  if (o.components.repulsion && share.repulsion) {
     const Var rep = repulsion(t, atlas.params.on(t, atlas.domain.means()), atlas.domain.sigma(),
                               RepulsionOptions{o.repulsion_tolerance});
     sum_terms.repulsion = double(t.scalar(rep));
-    total = add(t, total, scale(t, rep, T(n * o.weights.repulsion)));
+    plus(scale(t, rep, T(n * o.weights.repulsion)));
   }
-  if (atlas.has_codes() && o.weights.code > 0) {
-    // (1/N) sum_i (|f_phi,i|^2 + |f_psi,i|^2)
-    Var norms = sum(t, square(t, atlas.phi_code(t, 0)));
-    for (int i = 1; i < n; ++i) norms = add(t, norms, sum(t, square(t, atlas.phi_code(t, i))));
-    for (int i = 0; i < n; ++i) norms = add(t, norms, sum(t, square(t, atlas.psi_code(t, i))));
-    total = add(t, total, scale(t, norms, T(o.weights.code / n)));
+  if (atlas.has_codes() && o.weights.code > 0 && share.code_begin < share.code_end) {
+    // (1/N) sum_i (|f_phi,i|^2 + |f_psi,i|^2), over this share's codes
+    Var norms;
+    for (int i = share.code_begin; i < share.code_end; ++i) {
+      const Var phi_i = sum(t, square(t, atlas.phi_code(t, i)));
+      norms = norms.valid() ? add(t, norms, phi_i) : phi_i;
+    }
+    for (int i = share.code_begin; i < share.code_end; ++i)
+      norms = add(t, norms, sum(t, square(t, atlas.psi_code(t, i))));
+    plus(scale(t, norms, T(o.weights.code / n)));
   }
+  if (!total.valid())
+    total = t.constant(Block<T>::Zero(1, 1));  // a share with nothing in it this step
   sum_terms.total = double(t.scalar(total));
   if (terms) *terms = sum_terms;
   return total;
 }
 
-#define JSA_INSTANTIATE(T)                                                                        \
+template <class T>
+Var collection_objective(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>>& targets, Index m,
+                         Rng& rng, const ObjectiveOptions& o, LossTerms* terms,
+                         const std::vector<int>& batch,
+                         const std::vector<NearestIndex<T>>& surfaces) {
+  const int n = atlas.shapes();
+  const int b = int(targets.size());
+  if (batch.empty())
+    JSA_CHECK(b == n, targets.size() << " target sets for " << n << " shapes");
+  else
+    JSA_CHECK(b == int(batch.size()) && b > 0 && b <= n,
+              targets.size() << " target sets for a batch of " << batch.size());
+  JSA_CHECK(surfaces.empty() || int(surfaces.size()) == n,
+            surfaces.size() << " surface indexes for " << n << " shapes");
+  // The whole of L_full in one share; every shape draws from the one generator, in turn.
+  ObjectiveShare<T> share;
+  share.batch = b;
+  share.code_end = n;
+  for (int k = 0; k < b; ++k) {
+    const int shape = batch.empty() ? k : batch[size_t(k)];
+    share.shapes.push_back(shape);
+    share.rngs.push_back(&rng);
+    if (!surfaces.empty() && shape >= 0 && shape < n)
+      share.surfaces.push_back(&surfaces[size_t(shape)]);
+  }
+  LossTerms sums;
+  const Var total = objective_share(t, atlas, targets, m, o, share, &sums);
+  if (terms) {
+    *terms = sums;
+    for (double* v :
+         {&terms->surface, &terms->chart, &terms->cycle_2d, &terms->cycle_6d, &terms->isometry})
+      *v /= b;
+  }
+  return total;
+}
+
+#define JSA_INSTANTIATE(T)                                                                       \
   template Var single_shape_objective<T>(Tape<T>&, Atlas<T>&, int, const Block<T>&, Index, Rng&, \
                                          const ObjectiveOptions&, LossTerms*,                    \
                                          const NearestIndex<T>*);                                \
-  template Var collection_objective<T>(Tape<T>&, Atlas<T>&, const std::vector<Block<T>>&, Index, \
-                                       Rng&, const ObjectiveOptions&, LossTerms*,              \
-                                       const std::vector<int>&,                                \
-                                       const std::vector<NearestIndex<T>>&);
+  template Var collection_objective<T>(                                                          \
+      Tape<T>&, Atlas<T>&, const std::vector<Block<T>>&, Index, Rng&, const ObjectiveOptions&,   \
+      LossTerms*, const std::vector<int>&, const std::vector<NearestIndex<T>>&);                 \
+  template Var objective_share<T>(Tape<T>&, Atlas<T>&, const std::vector<Block<T>>&, Index,      \
+                                  const ObjectiveOptions&, const ObjectiveShare<T>&, LossTerms*);
 JSA_INSTANTIATE(float)
 JSA_INSTANTIATE(double)
 

@@ -16,12 +16,12 @@
 namespace jsa {
 
 struct LossWeights {
-  double surface = 1.0;     // l_6D, on L_6D (Eq. 7)
-  double chart = 1e-2;      // l_2D, on L_2D (Eq. 8)
-  double cycle = 1.0;       // l_cycle, on L_cycle (Eq. 9), mean convention (FitOptions: 0.1)
-  double isometry = 1e-4;   // l_iso, on L_iso (Eq. 10), mean convention
-  double repulsion = 1.0;   // l_rep, on L_rep (Eq. 11)
-  double code = 1e-4;       // collections: weight of the mean squared norm of the latent codes
+  double surface = 1.0;    // l_6D, on L_6D (Eq. 7)
+  double chart = 1e-2;     // l_2D, on L_2D (Eq. 8)
+  double cycle = 1.0;      // l_cycle, on L_cycle (Eq. 9), mean convention (FitOptions: 0.1)
+  double isometry = 1e-4;  // l_iso, on L_iso (Eq. 10), mean convention
+  double repulsion = 1.0;  // l_rep, on L_rep (Eq. 11)
+  double code = 1e-4;      // collections: weight of the mean squared norm of the latent codes
 };
 
 // Which parts of the method are on. The default is Table 1 row 11, the full method.
@@ -37,8 +37,7 @@ struct Components {
 
 // The value of each term at the last evaluation (unweighted), and the total.
 struct LossTerms {
-  double total = 0, surface = 0, chart = 0, cycle_2d = 0, cycle_6d = 0, isometry = 0,
-         repulsion = 0;
+  double total = 0, surface = 0, chart = 0, cycle_2d = 0, cycle_6d = 0, isometry = 0, repulsion = 0;
 };
 
 struct ObjectiveOptions {
@@ -70,5 +69,28 @@ Var collection_objective(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>
                          Index samples, Rng& rng, const ObjectiveOptions& o, LossTerms* terms,
                          const std::vector<int>& batch = {},
                          const std::vector<NearestIndex<T>>& surfaces = {});
+
+// One process's share of L_full (Eq. 12) in a data-parallel fit (docs/mpi.md):
+// L_full is a sum, so the shares of P processes add up to it. A share holds
+// some of the step's shapes (each with its own generator of the draws from P,
+// so that a shape draws the same x_P whichever process holds it), the prior of
+// some codes, and N l_rep L_rep in exactly one share (L_rep depends on mu alone).
+template <class T>
+struct ObjectiveShare {
+  std::vector<int> shapes;                       // the shape of each target set
+  std::vector<Rng*> rngs;                        // per target set: the draws of x_P
+  std::vector<const NearestIndex<T>*> surfaces;  // empty, or per target set (dense L_6D)
+  int batch = 0;                     // B: the step's shapes over all shares (scale N / B)
+  bool repulsion = true;             // this share adds N l_rep L_rep
+  int code_begin = 0, code_end = 0;  // this share adds the prior of codes [begin, end)
+};
+
+// The share's part of L_full. sums receives the per-shape terms SUMMED over the
+// share's shapes (not averaged: shares are added, then divided by B), the share's
+// L_rep (0 without it) and its total.
+template <class T>
+Var objective_share(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>>& targets,
+                    Index samples, const ObjectiveOptions& o, const ObjectiveShare<T>& share,
+                    LossTerms* sums);
 
 }  // namespace jsa

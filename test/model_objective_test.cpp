@@ -174,6 +174,67 @@ TEST_CASE("objective: a batch of B of N shapes is their sum scaled by N / B", "[
                   InternalError);
 }
 
+TEST_CASE("objective: the shares of a data-parallel step add up to L_full and its gradient",
+          "[objective]") {
+  // Three shapes split as two processes would hold them, {0, 1} and {2}: the
+  // values and the gradients of the two shares add up to those of one share
+  // holding all three (docs/mpi.md), with L_rep and each code's prior counted once.
+  AtlasOptions ao = small_atlas_options();
+  ao.shapes = 3;
+  ao.code_size = 4;
+  Atlas<double> atlas(ao);
+  Rng init(21);
+  atlas.initialize(init);
+  std::vector<Block<double>> targets;
+  for (uint64_t s = 0; s < 3; ++s) targets.push_back(random_targets(24, ao.alpha, 22 + s));
+  ObjectiveOptions o;
+  o.weights.code = 0.5;  // large enough that a code counted twice or not at all shows
+  auto share_of = [&](std::vector<int> shapes, bool repulsion, int code_begin, int code_end,
+                      std::vector<double>& grad, LossTerms& sums) {
+    std::vector<Rng> rngs;
+    for (int s : shapes)
+      rngs.emplace_back(31, uint64_t(s));  // per shape, as the trainer seeds them
+    ObjectiveShare<double> share;
+    share.shapes = shapes;
+    for (Rng& r : rngs) share.rngs.push_back(&r);
+    share.batch = 3;
+    share.repulsion = repulsion;
+    share.code_begin = code_begin;
+    share.code_end = code_end;
+    std::vector<Block<double>> mine;
+    for (int s : shapes) mine.push_back(targets[size_t(s)]);
+    Tape<double> tape;
+    const Var loss = objective_share(tape, atlas, mine, 24, o, share, &sums);
+    atlas.params.zero_grad();
+    tape.backward(loss);
+    grad = atlas.params.grads();
+    return tape.scalar(loss);
+  };
+  std::vector<double> g_all, g_a, g_b;
+  LossTerms t_all, t_a, t_b;
+  const double all = share_of({0, 1, 2}, true, 0, 3, g_all, t_all);
+  const double a = share_of({0, 1}, true, 0, 2, g_a, t_a);
+  const double b = share_of({2}, false, 2, 3, g_b, t_b);
+  CHECK(a + b == Approx(all).epsilon(1e-12));
+  CHECK(t_a.surface + t_b.surface == Approx(t_all.surface).epsilon(1e-12));
+  CHECK(t_b.repulsion == 0);
+  CHECK(t_a.repulsion == t_all.repulsion);
+  double worst = 0, largest = 0;
+  for (size_t i = 0; i < g_all.size(); ++i) {
+    worst = std::max(worst, std::abs(g_a[i] + g_b[i] - g_all[i]));
+    largest = std::max(largest, std::abs(g_all[i]));
+  }
+  CHECK(largest > 0);
+  CHECK(worst <= 1e-12 * largest);
+  // A share with no shape this step (a rank outside a --batch-shapes subset) is
+  // just its codes' prior, and differentiable.
+  std::vector<double> g_empty;
+  LossTerms t_empty;
+  const double empty = share_of({}, false, 2, 3, g_empty, t_empty);
+  CHECK(empty > 0);
+  CHECK(t_empty.surface == 0);
+}
+
 TEST_CASE(
     "objective: dense L_6D equals Eq. 7 when the pool is the step's targets, and is differentiable",
     "[objective]") {

@@ -9,6 +9,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <tuple>
 
 #include "model/heuristics/orientation.h"
 #include "model/heuristics/reseed.h"
@@ -43,11 +44,26 @@ static void validate(const FitOptions& o) {
   require(o.fault_lr_factor > 0 && o.fault_lr_factor <= 1, "fault_lr_factor must be in (0, 1]");
 }
 
-Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools)
-    : options_(o), rng_(o.seed, 0) {
+Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools, Team* team)
+    : options_(o), team_(team), rng_(o.seed, 0) {
   JSA_CHECK(!pools.empty(), "no shapes to fit");
   validate(o);
-  for (const Block<double>& pool : pools) {
+  const int n = int(pools.size());
+  const int ranks = team ? team->size() : 1;
+  if (ranks > n)
+    throw InputError(std::to_string(ranks) + " MPI ranks for " + std::to_string(n) +
+                     " shapes: run at most one rank per shape");
+  if (ranks > 1 && o.wrap_steps > 0)
+    throw InputError("wrap_steps is not supported with more than one MPI rank");
+  if (ranks > 1 && o.reseed_every > 0)
+    throw InputError("reseed_every is not supported with more than one MPI rank");
+  std::tie(first_shape_, last_shape_) = jsa::shape_block(n, ranks, team ? team->rank() : 0);
+  for (int i = 0; i < n; ++i) {
+    const Block<double>& pool = pools[size_t(i)];
+    if (i < first_shape_ || i >= last_shape_) {
+      pools_.emplace_back(0, 6);  // another rank's shape
+      continue;
+    }
     JSA_CHECK(pool.cols() == 6 && pool.rows() > 0, "a target pool must be P x 6");
     pools_.push_back(pool.cast<float>());
     pools_.back().rightCols(3) *= float(o.atlas.alpha);
@@ -55,9 +71,7 @@ Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools)
       surfaces_.emplace_back(o.components.normals ? pools_.back()
                                                   : Block<float>(pools_.back().leftCols(3)));
   }
-  const int n = int(pools.size());
   const int b = o.batch_shapes > 0 && o.batch_shapes < n ? o.batch_shapes : n;
-  targets_.assign(size_t(b), Block<float>(o.points, 6));
   for (int i = 0; i < b; ++i) batch_.push_back(i);
   options_.atlas.shapes = int(pools.size());
   AtlasOptions ao = options_.atlas;
@@ -65,6 +79,13 @@ Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools)
   atlas_ = std::make_unique<Atlas<float>>(ao);
   Rng init(o.seed, 1);
   atlas_->initialize(init);
+  // Every parameter but the codes is shared by all shapes: its gradient is summed over the ranks.
+  const Parameters<float>& p = atlas_->params;
+  for (int e = 0; e < p.count(); ++e) {
+    const auto& entry = p.entry(e);
+    if (entry.name == "codes.phi" || entry.name == "codes.psi") continue;
+    shared_.push_back({entry.offset, size_t(entry.rows * entry.cols)});
+  }
   take_snapshot(rng_.state());
 }
 
@@ -118,38 +139,67 @@ void Trainer::step() {
   const std::array<uint64_t, 4> rng_at_start = rng_.state();
   const int n = int(pools_.size()), b = int(batch_.size());
   if (b < n) {
-    // A uniform subset of B shapes: the first B of a partial Fisher-Yates shuffle.
+    // A uniform subset of B shapes: the first B of a partial Fisher-Yates shuffle
+    // (the same on every rank: rng_ is).
     std::vector<int> order(static_cast<size_t>(n));
     for (int i = 0; i < n; ++i) order[size_t(i)] = i;
     for (int i = 0; i < b; ++i)
       std::swap(order[size_t(i)], order[size_t(i) + rng_.below(uint64_t(n - i))]);
     batch_.assign(order.begin(), order.begin() + b);
   }
-  // M targets {x_S, n_S} per shape of the batch, drawn with replacement from its pool.
-  for (int k = 0; k < b; ++k) {
-    const Block<float>& pool = pools_[size_t(batch_[size_t(k)])];
+  // Each shape draws its targets and its x_P from a generator of its own, seeded
+  // by the step's key and the shape's index: the same numbers whichever rank
+  // trains the shape, and in one process (docs/mpi.md). The key comes from rng_,
+  // so a restored snapshot replays them.
+  const uint64_t key = rng_.next();
+  local_.clear();
+  for (int s : batch_)
+    if (s >= first_shape_ && s < last_shape_) local_.push_back(s);
+  targets_.resize(local_.size(), Block<float>(options_.points, 6));
+  shape_rngs_.clear();
+  for (int s : local_) shape_rngs_.emplace_back(key, uint64_t(s));
+  ObjectiveShare<float> share;
+  share.shapes = local_;
+  share.batch = b;
+  share.repulsion = first_shape_ == 0;  // rank 0: N l_rep L_rep is counted once
+  share.code_begin = first_shape_;
+  share.code_end = last_shape_;
+  // M targets {x_S, n_S} per shape, drawn with replacement from its pool.
+  for (size_t k = 0; k < local_.size(); ++k) {
+    const Block<float>& pool = pools_[size_t(local_[k])];
+    Rng& rng = shape_rngs_[k];
     for (Index m = 0; m < options_.points; ++m)
-      targets_[size_t(k)].row(m) = pool.row(Index(rng_.below(uint64_t(pool.rows()))));
+      targets_[k].row(m) = pool.row(Index(rng.below(uint64_t(pool.rows()))));
+    share.rngs.push_back(&rng);
+    if (!surfaces_.empty()) share.surfaces.push_back(&surfaces_[size_t(local_[k] - first_shape_)]);
   }
   tape_.clear();
   const ObjectiveOptions objective{options_.weights, options_.components,
                                    options_.repulsion_tolerance};
-  Var loss = collection_objective(tape_, *atlas_, targets_, options_.points, rng_, objective,
-                                  &last_, b < n ? batch_ : std::vector<int>{}, surfaces_);
+  LossTerms sums;
+  Var loss = objective_share(tape_, *atlas_, targets_, options_.points, objective, share, &sums);
   atlas_->params.zero_grad();
   tape_.backward(loss);
   if (iteration_ == fault_at_ && faults_to_inject_ > 0) {
     --faults_to_inject_;
-    last_.total = std::numeric_limits<double>::quiet_NaN();
+    sums.total = std::numeric_limits<double>::quiet_NaN();
   }
-  bool finite = std::isfinite(last_.total);
+  bool finite = std::isfinite(sums.total);
   for (float g : atlas_->params.grads()) finite = finite && std::isfinite(g);
+  // Over MPI the flag is summed with the loss terms: when any rank saw a NaN or
+  // Inf, every rank takes the same recovery below, from the same snapshot.
+  if (team_ && team_->size() > 1) finite = exchange(sums, finite);
+  last_ = sums;
+  for (double* v :
+       {&last_.surface, &last_.chart, &last_.cycle_2d, &last_.cycle_6d, &last_.isometry})
+    *v /= b;
   StepReport report;
   report.lr = learning_rate();
   report.terms = last_;
   if (!finite) {
     // Undo: back to the last good state, whole; this batch is skipped and the
-    // steps since the snapshot are redone with the smaller learning rate.
+    // steps since the snapshot are redone with the smaller learning rate. Every
+    // rank takes its snapshot at the same iterations, so all rewind together.
     FaultRecovery f;
     f.iteration = iteration_;
     restore_snapshot();
@@ -180,18 +230,63 @@ void Trainer::step() {
     throw NumericalFault(unresolved_faults_, failed_iteration_);
 }
 
+// The step's sums over the ranks, in rank order (model/tool/team.h): the loss
+// terms, whether every rank's loss and gradient were finite, and the gradient of
+// the shared parameters. The codes' gradients stay on the rank of their shape.
+bool Trainer::exchange(LossTerms& sums, bool finite) {
+  double terms[8] = {sums.total,    sums.surface,  sums.chart,     sums.cycle_2d,
+                     sums.cycle_6d, sums.isometry, sums.repulsion, finite ? 0.0 : 1.0};
+  team_->sum_in_rank_order(terms, 8);
+  sums = LossTerms{terms[0], terms[1], terms[2], terms[3], terms[4], terms[5], terms[6]};
+  if (terms[7] != 0 || !std::isfinite(sums.total)) return false;
+  std::vector<float>& grads = atlas_->params.grads();
+  exchange_.clear();
+  for (const auto& [offset, length] : shared_)
+    exchange_.insert(exchange_.end(), &grads[offset], &grads[offset] + length);
+  team_->sum_in_rank_order(exchange_.data(), exchange_.size());
+  size_t at = 0;
+  for (const auto& [offset, length] : shared_) {
+    std::copy(exchange_.begin() + std::ptrdiff_t(at),
+              exchange_.begin() + std::ptrdiff_t(at + length), &grads[offset]);
+    at += length;
+  }
+  return true;
+}
+
+void Trainer::gather_codes() {
+  if (!team_ || team_->size() == 1 || !atlas_->has_codes()) return;
+  Parameters<float>& p = atlas_->params;
+  const size_t d = size_t(p.entry(p.find("codes.phi")).cols);
+  for (std::vector<float>* buffer : {&p.values(), &adam_.first_moment(), &adam_.second_moment()}) {
+    if (buffer->empty()) continue;  // Adam's moments before the first step, on every rank
+    for (const char* name : {"codes.phi", "codes.psi"}) {
+      // Rows of other ranks' shapes to zero, then a sum: each row keeps its owner's value exactly.
+      const auto& entry = p.entry(p.find(name));
+      float* codes = buffer->data() + entry.offset;
+      for (int s = 0; s < atlas_->shapes(); ++s)
+        if (s < first_shape_ || s >= last_shape_)
+          std::fill(codes + size_t(s) * d, codes + size_t(s + 1) * d, 0.0f);
+      team_->sum_in_rank_order(codes, size_t(entry.rows) * d);
+    }
+  }
+}
+
 bool Trainer::choose_orientation() {
   const int every = options_.orient_every;
   if (every <= 0 || !options_.components.normals || iteration_ % every != 0) return false;
   const double first_decay = options_.decay_at.empty() ? 1.0 : options_.decay_at.front();
   if (double(iteration_) >= first_decay * double(options_.iterations)) return false;
-  // Its own stream: the check does not shift the draws of the training steps.
-  Rng rng(options_.seed, 1000 + uint64_t(iteration_ / every));
+  // Its own streams, one per shape: the check does not shift the draws of the
+  // training steps, and a shape draws the same on any rank.
+  const Rng check(options_.seed, 1000 + uint64_t(iteration_ / every));
   double back = 0;
-  for (size_t i = 0; i < targets_.size(); ++i)
+  for (size_t i = 0; i < targets_.size(); ++i) {
+    Rng rng = check.stream(uint64_t(local_[i]));
     back += back_facing_fraction(*atlas_, targets_[i], std::min<Index>(options_.points, 2000), rng,
-                                 batch_[i]);
-  if (back / double(targets_.size()) <= 0.5) return false;
+                                 local_[i]);
+  }
+  if (team_ && team_->size() > 1) team_->sum_in_rank_order(&back, 1);
+  if (back / double(batch_.size()) <= 0.5) return false;
   mirror_domain(*atlas_, {&adam_.first_moment(), &adam_.second_moment()});
   ++mirrors_;
   take_snapshot(rng_.state());  // a fault must not restore the unmirrored state

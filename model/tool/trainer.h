@@ -15,6 +15,7 @@
 #include "engine/adam.h"
 #include "model/heuristics/wrap.h"
 #include "model/objective.h"
+#include "model/tool/team.h"
 
 namespace jsa {
 
@@ -155,8 +156,11 @@ class Trainer {
   // pools: per shape, P x 6 rows [x_S, n_S] in the shape's unit frame, n_S unit
   // length (scaled by alpha here). Drawn once; each step takes M rows of each.
   // More than one pool makes a collection: options.atlas.shapes is set to their count.
+  // team: a data-parallel run (model/tool/team.h, docs/mpi.md); this rank trains
+  // the shapes of its block, and only their pools are needed (the others may be
+  // empty). The team must outlive the trainer; null: one process.
   // Throws InputError naming the setting when options are out of range.
-  Trainer(const FitOptions& options, const std::vector<Block<double>>& pools);
+  Trainer(const FitOptions& options, const std::vector<Block<double>>& pools, Team* team = nullptr);
   Trainer(const FitOptions& options, const Block<double>& pool)
       : Trainer(options, std::vector<Block<double>>{pool}) {}
   // Receives a StepReport after every call of step(), faults included.
@@ -201,6 +205,12 @@ class Trainer {
   TrainerState save_state() const;
   // Throws InputError naming `what` when a part is malformed or does not match.
   void load_state(const TrainerState& state, const std::string& what);
+  // Every rank: brings the codes of every shape (values and Adam's moments) from
+  // the rank that trains them to all ranks, so that rank 0 can save or use the
+  // whole atlas. A collective call; nothing to do in one process.
+  void gather_codes();
+  // The shapes [first, last) this rank trains (all of them in one process).
+  std::pair<int, int> shape_block() const { return {first_shape_, last_shape_}; }
   Tape<float>& tape() { return tape_; }
 
   // The last good state is refreshed every this many iterations.
@@ -208,18 +218,28 @@ class Trainer {
 
  private:
   FitOptions options_;
-  std::vector<Block<float>> pools_;            // per shape P x 6, normals scaled by alpha
-  std::vector<NearestIndex<float>> surfaces_;  // per shape, over its pool (dense L_6D only)
+  std::vector<Block<float>>
+      pools_;  // per shape P x 6, normals scaled by alpha (this rank's shapes only)
+  std::vector<NearestIndex<float>>
+      surfaces_;  // per shape of the block, over its pool (dense L_6D only)
+  Team* team_ = nullptr;
+  int first_shape_ = 0, last_shape_ = 0;  // this rank's block of shapes
+  std::vector<std::pair<size_t, size_t>>
+      shared_;                   // (offset, length) of the parameters every rank trains
+  std::vector<float> exchange_;  // their gradients, packed for the team's sum
   std::unique_ptr<Atlas<float>> atlas_;
   Adam<float> adam_;
   Tape<float> tape_;
   Rng rng_;
   int64_t iteration_ = 0;
   LossTerms last_;
-  std::vector<Block<float>> targets_;  // per shape of the step's batch
-  std::vector<int> batch_;             // the shapes of the step (all N without batching)
+  std::vector<Block<float>> targets_;  // per shape of local_
+  std::vector<int> batch_;       // the shapes of the step (all N without batching), on every rank
+  std::vector<int> local_;       // those of this rank's block
+  std::vector<Rng> shape_rngs_;  // per shape of local_: its draws this step
   StepCallback progress_;
-  // The last good state: everything the next step depends on.
+  // The last good state: everything the next step depends on. Over MPI every
+  // rank takes it at the same iteration and restores it together.
   struct Snapshot {
     std::vector<float> params, m, v;
     int64_t adam_steps = 0, iteration = 0;
@@ -239,6 +259,7 @@ class Trainer {
   void restore_snapshot();
   bool choose_orientation();
   int reseed();
+  bool exchange(LossTerms& sums, bool finite);
 };
 
 }  // namespace jsa

@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# The MPI tests of `jsatlas fit` (docs/mpi.md), one CTest test per mode:
+#   reference    the 1-process fit of 4 builtin shapes (the others compare with it)
+#   np2, np3     mpirun -np 2 / -np 3 (3 ranks on 4 shapes: an uneven split);
+#                parameters within BOUND of the reference, relative to the largest
+#   determinism  mpirun -np 2 a second time: bit-identical to np2's checkpoint
+#   resume       -np 2 stopped at iteration 6, resumed with -np 3: within BOUND
+#   batch        --batch-shapes 3 on 1 process and on 2 ranks: within BOUND
+#   errors       more ranks than shapes, --wrap over 2 ranks: a one-line error, the job ends non-zero
+# Usage: run_tests.sh MODE JSATLAS COMPARE MPIEXEC WORKDIR BOUND
+set -euo pipefail
+mode=$1 jsatlas=$2 compare=$3 mpiexec=$4 work=$5 bound=$6
+mkdir -p "$work"
+cd "$work"
+printf 'builtin:sphere\nbuiltin:torus\nbuiltin:cube\nbuiltin:capsule\n' > shapes.txt
+# Small enough for seconds per run; orientation checks every 4 steps exercise its sum over ranks.
+fit=(fit --list shapes.txt --iters 12 -M 64 -K 64 --width 16 --depth 2 --code-size 8 --pool 2000
+     --threads 1 --orient-every 4 --mesh-resolution 8 --checkpoint-every 0 --seed 5 -q)
+launch=("$mpiexec" --oversubscribe --bind-to none)
+[ "$(id -u)" -eq 0 ] && launch+=(--allow-run-as-root)
+run() {  # run NP ARGS...: one process without mpirun, else NP ranks
+  local np=$1; shift
+  if [ "$np" -eq 1 ]; then "$jsatlas" "$@"; else "${launch[@]}" -np "$np" "$jsatlas" "$@"; fi
+}
+case "$mode" in
+  reference)
+    rm -rf one && run 1 "${fit[@]}" -o one
+    rm -rf one_batch && run 1 "${fit[@]}" --batch-shapes 3 -o one_batch ;;
+  np2 | np3)
+    np=${mode#np}
+    rm -rf "$mode" && run "$np" "${fit[@]}" -o "$mode"
+    "$compare" one/model.ckpt "$mode/model.ckpt" "$bound"
+    # Rank 0 wrote every output of the collection.
+    for i in 0 1 2 3; do test -s "$mode/shape_$i/domain_mesh.obj"; done
+    test -s "$mode/losses.csv" ;;
+  determinism)
+    rm -rf np2_again && run 2 "${fit[@]}" -o np2_again
+    "$compare" np2/model.ckpt np2_again/model.ckpt
+    cmp np2/model.ckpt np2_again/model.ckpt
+    cmp np2/losses.csv np2_again/losses.csv ;;
+  resume)
+    rm -rf resumed && run 2 "${fit[@]}" --stop-at 6 -o resumed
+    grep -q '^6,' resumed/losses.csv || { echo "resume: no row 6 in losses.csv"; exit 1; }
+    run 3 fit --resume resumed -q
+    "$compare" one/model.ckpt resumed/model.ckpt "$bound"
+    # and back to one process from a 3-rank checkpoint
+    rm -rf resumed1 && run 3 "${fit[@]}" --stop-at 9 -o resumed1
+    run 1 fit --resume resumed1 -q
+    "$compare" one/model.ckpt resumed1/model.ckpt "$bound" ;;
+  batch)
+    rm -rf np2_batch && run 2 "${fit[@]}" --batch-shapes 3 -o np2_batch
+    "$compare" one_batch/model.ckpt np2_batch/model.ckpt "$bound" ;;
+  errors)
+    expect_error() {  # expect_error MESSAGE NP ARGS...: the job fails and names the reason
+      local message=$1 np=$2; shift 2
+      if run "$np" "$@" > err.txt 2>&1; then echo "errors: '$*' on $np ranks succeeded"; exit 1; fi
+      grep -q -- "$message" err.txt || { echo "errors: no '$message' in:"; cat err.txt; exit 1; }
+    }
+    expect_error "2 MPI ranks for 1 shapes" 2 fit builtin:sphere -o too_many --iters 2 -q
+    expect_error "--wrap is not supported with more than one MPI rank" 2 "${fit[@]}" --wrap 5 -o wrapped ;;
+  *) echo "run_tests.sh: unknown mode $mode"; exit 2 ;;
+esac
