@@ -284,7 +284,8 @@ void write_table(const Args& a, const std::map<std::pair<int, int>, json>& runs,
   md << "\n- Budget per run: " << f.iterations << " iterations, M = " << f.points
      << " points per shape per step, K = " << f.atlas.gaussians << " Gaussians (rows 6-11), MLPs "
      << f.atlas.hidden_layers << " x " << f.atlas.width
-     << (f.atlas.softplus_beta > 0 ? " softplus " + std::to_string(f.atlas.softplus_beta) : std::string(" ReLU"))
+     << (f.atlas.softplus_beta > 0 ? " softplus " + std::to_string(f.atlas.softplus_beta)
+                                   : std::string(" ReLU"))
      << " (phi and psi; each of the P patch MLPs of rows 1-4), latent codes D = "
      << f.atlas.code_size << ", Adam lr " << f.lr << " decayed x" << f.decay << " at";
   for (double d : f.decay_at) md << " " << d;

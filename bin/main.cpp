@@ -5,8 +5,9 @@
 #include "engine/check.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"jsatlas: learn joint surface atlases of meshes and point clouds\n"
-               "(Deprelle, Groueix, Aigerman, Kim, Aubry: Learning Joint Surface Atlases, NeurIPS 2022)"};
+  CLI::App app{
+      "jsatlas: learn joint surface atlases of meshes and point clouds\n"
+      "(Deprelle, Groueix, Aigerman, Kim, Aubry: Learning Joint Surface Atlases, NeurIPS 2022)"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "jsatlas 0.1.0");
   jsa::cli::add_fit(app);
@@ -25,7 +26,8 @@ int main(int argc, char** argv) {
       names += (names.empty() ? "" : ", ") + sub->get_name();
     }
     if (!known) {
-      std::cerr << "jsatlas: unknown command '" << argv[1] << "' (commands: " << names << "; see --help)\n";
+      std::cerr << "jsatlas: unknown command '" << argv[1] << "' (commands: " << names
+                << "; see --help)\n";
       return 2;
     }
   }

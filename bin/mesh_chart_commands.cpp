@@ -47,14 +47,27 @@ int checked_shape(const LoadedRun& r, int shape) {
 
 void add_mesh(CLI::App& app) {
   auto a = std::make_shared<MeshArgs>();
-  CLI::App* c = app.add_subcommand("mesh", "Mesh the learned domain (threshold of P) and map it through phi: OBJ with UVs");
+  CLI::App* c = app.add_subcommand(
+      "mesh", "Mesh the learned domain (threshold of P) and map it through phi: OBJ with UVs");
   c->add_option("run", a->run, "Run directory (holds model.ckpt)")->required();
-  c->add_option("-o,--out", a->out, "Output OBJ (an .mtl, texture PNG, _uv.json report and .png views are written next to it)")->required();
-  c->add_option("--resolution", a->options.resolution, "Grid cells across the domain")->capture_default_str()->check(CLI::Range(8, 4096));
-  c->add_option("--threshold", a->options.threshold, "Domain = {P >= t * median of P at the means}")->capture_default_str()->check(CLI::Range(0.0, 100.0));
-  c->add_option("--threads", a->threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
-  c->add_option("--shape", a->shape, "Which shape of a collection (0-based)")->capture_default_str();
-  c->add_option("--texture", a->options.texture, "An image for the MTL instead of the built-in colour chart (a texture made for one shape of a collection fits every shape)");
+  c->add_option(
+       "-o,--out", a->out,
+       "Output OBJ (an .mtl, texture PNG, _uv.json report and .png views are written next to it)")
+      ->required();
+  c->add_option("--resolution", a->options.resolution, "Grid cells across the domain")
+      ->capture_default_str()
+      ->check(CLI::Range(8, 4096));
+  c->add_option("--threshold", a->options.threshold, "Domain = {P >= t * median of P at the means}")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100.0));
+  c->add_option("--threads", a->threads, "Threads (0: all cores)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1024));
+  c->add_option("--shape", a->shape, "Which shape of a collection (0-based)")
+      ->capture_default_str();
+  c->add_option("--texture", a->options.texture,
+                "An image for the MTL instead of the built-in colour chart (a texture made for one "
+                "shape of a collection fits every shape)");
   c->add_flag("-q,--quiet", a->options.quiet, "No report on the terminal");
   c->callback([a]() {
     set_threads(a->threads);
@@ -66,15 +79,27 @@ void add_mesh(CLI::App& app) {
 
 void add_chart(CLI::App& app) {
   auto a = std::make_shared<ChartArgs>();
-  CLI::App* c = app.add_subcommand("chart", "UV map of a mesh through the chart psi (vertex and face order kept): OBJ with vt");
+  CLI::App* c = app.add_subcommand(
+      "chart", "UV map of a mesh through the chart psi (vertex and face order kept): OBJ with vt");
   c->add_option("run", a->run, "Run directory (holds model.ckpt)")->required();
   c->add_option("input", a->input, "The mesh to chart (default: the run's own input)");
-  c->add_option("-o,--out", a->out, "Output OBJ (.mtl, texture, _uv.json report, .png and _layout.png next to it)")->required();
-  c->add_flag("--split-cuts", a->options.split_cuts, "Give triangles torn across the cut their own UV corners");
-  c->add_option("--torn-ratio", a->options.torn_ratio, "A UV edge this many times longer than its 3D edge (areas equalised) is torn")->capture_default_str()->check(CLI::Range(1.0, 1e6));
-  c->add_option("--threads", a->threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
-  c->add_option("--shape", a->shape, "Which shape of a collection (0-based)")->capture_default_str();
-  c->add_option("--texture", a->options.texture, "An image for the MTL instead of the built-in colour chart (a texture made for one shape of a collection fits every shape)");
+  c->add_option("-o,--out", a->out,
+                "Output OBJ (.mtl, texture, _uv.json report, .png and _layout.png next to it)")
+      ->required();
+  c->add_flag("--split-cuts", a->options.split_cuts,
+              "Give triangles torn across the cut their own UV corners");
+  c->add_option("--torn-ratio", a->options.torn_ratio,
+                "A UV edge this many times longer than its 3D edge (areas equalised) is torn")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 1e6));
+  c->add_option("--threads", a->threads, "Threads (0: all cores)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1024));
+  c->add_option("--shape", a->shape, "Which shape of a collection (0-based)")
+      ->capture_default_str();
+  c->add_option("--texture", a->options.texture,
+                "An image for the MTL instead of the built-in colour chart (a texture made for one "
+                "shape of a collection fits every shape)");
   c->add_flag("-q,--quiet", a->options.quiet, "No report on the terminal");
   c->callback([a]() {
     set_threads(a->threads);

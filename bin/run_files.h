@@ -13,10 +13,10 @@ namespace jsa::cli {
 std::string json_quote(const std::string& s);
 
 struct MeshOutputOptions {
-  int resolution = 256;    // grid cells across the domain
+  int resolution = 256;     // grid cells across the domain
   double threshold = 0.05;  // domain = {P >= threshold * median of P at the means}
   bool quiet = false;
-  std::string texture;      // the user's image for the MTLs (empty: the built-in colour chart)
+  std::string texture;  // the user's image for the MTLs (empty: the built-in colour chart)
 };
 // OUT.obj (+ .mtl, texture PNG, _uv.json report, .png three views): the
 // thresholded domain mapped through phi, in the input's frame.
@@ -27,7 +27,7 @@ struct ChartOutputOptions {
   bool split_cuts = false;  // give torn triangles their own UV corners (no smeared triangles)
   double torn_ratio = 10;   // a UV edge this many times longer than its 3D edge is torn
   bool quiet = false;
-  std::string texture;      // the user's image for the MTL (empty: the built-in colour chart)
+  std::string texture;  // the user's image for the MTL (empty: the built-in colour chart)
 };
 // OUT.obj with the user's vertices and faces in their order and vt from psi,
 // OUT_uv.json, OUT.png (three views coloured through the chart), OUT_layout.png.

@@ -38,12 +38,22 @@ void run_show(const ShowArgs& a) {
 
 void add_show(CLI::App& app) {
   auto a = std::make_shared<ShowArgs>();
-  CLI::App* c = app.add_subcommand("show", "Regenerate a run's meshes, UV reports and pictures from its checkpoint");
+  CLI::App* c = app.add_subcommand(
+      "show", "Regenerate a run's meshes, UV reports and pictures from its checkpoint");
   c->add_option("run", a->run, "Run directory (holds model.ckpt)")->required();
-  c->add_option("--mesh-resolution", a->mesh.resolution, "Grid cells across the domain")->capture_default_str()->check(CLI::Range(8, 4096));
-  c->add_option("--mesh-threshold", a->mesh.threshold, "Domain = {P >= t * median of P at the means}")->capture_default_str()->check(CLI::Range(0.0, 100.0));
-  c->add_option("--threads", a->threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
-  c->add_option("--texture", a->mesh.texture, "An image for every MTL; also writes texture_transfer.png (the image on every input through its chart)");
+  c->add_option("--mesh-resolution", a->mesh.resolution, "Grid cells across the domain")
+      ->capture_default_str()
+      ->check(CLI::Range(8, 4096));
+  c->add_option("--mesh-threshold", a->mesh.threshold,
+                "Domain = {P >= t * median of P at the means}")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100.0));
+  c->add_option("--threads", a->threads, "Threads (0: all cores)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1024));
+  c->add_option("--texture", a->mesh.texture,
+                "An image for every MTL; also writes texture_transfer.png (the image on every "
+                "input through its chart)");
   c->add_flag("-q,--quiet", a->mesh.quiet, "No reports on the terminal");
   c->callback([a]() { run_show(*a); });
 }

@@ -24,9 +24,10 @@ TEST_CASE("cli: bad inputs and flags give one line and a non-zero exit", "[cli]"
   write_text(dir + "/empty.obj", "");
   write_text(dir + "/nan.off", "OFF\n3 1 0\n0 0 0\nnan 1 0\n0 1 0\n3 0 1 2\n");
   write_text(dir + "/range.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
-  write_text(dir + "/garbage.ply", std::string("ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\n"
-                                               "property float x\nproperty float y\nproperty float z\nend_header\n") +
-                                       std::string(64, '\x7f'));
+  write_text(dir + "/garbage.ply",
+             std::string("ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\n"
+                         "property float x\nproperty float y\nproperty float z\nend_header\n") +
+                 std::string(64, '\x7f'));
   write_text(dir + "/shape.xyz", "0 0 0\n1 0 0\n");
   expect_error("fit " + dir + "/missing.obj -o " + dir + "/out", 1, "missing.obj");
   expect_error("fit " + dir + " -o " + dir + "/out", 1, dir);
@@ -52,8 +53,10 @@ TEST_CASE("cli: bad inputs and flags give one line and a non-zero exit", "[cli]"
 
 TEST_CASE("cli: a corrupted or truncated checkpoint is rejected, never half-loaded", "[cli]") {
   const std::string dir = fresh_dir("ckpt");
-  REQUIRE(run("fit builtin:sphere -o " + dir + " --iters 5 -K 100 -M 100 --width 8 --depth 1 --threads 1 "
-              "--pool 1000 --mesh-resolution 16 -q").code == 0);
+  REQUIRE(run("fit builtin:sphere -o " + dir +
+              " --iters 5 -K 100 -M 100 --width 8 --depth 1 --threads 1 "
+              "--pool 1000 --mesh-resolution 16 -q")
+              .code == 0);
   const std::string good = read_text(dir + "/model.ckpt");
   std::string flipped = good;
   flipped[flipped.size() / 2] ^= 0x20;
@@ -67,8 +70,10 @@ TEST_CASE("cli: a corrupted or truncated checkpoint is rejected, never half-load
 
 TEST_CASE("cli: a failing output never damages the file the user had", "[cli]") {
   const std::string dir = fresh_dir("keep");
-  REQUIRE(run("fit builtin:sphere -o " + dir + " --iters 5 -K 100 -M 100 --width 8 --depth 1 --threads 1 "
-              "--pool 1000 --mesh-resolution 16 -q").code == 0);
+  REQUIRE(run("fit builtin:sphere -o " + dir +
+              " --iters 5 -K 100 -M 100 --width 8 --depth 1 --threads 1 "
+              "--pool 1000 --mesh-resolution 16 -q")
+              .code == 0);
   write_text(dir + "/mine.obj", "precious\n");
   // A threshold no cell reaches: the command fails before writing anything.
   expect_error("mesh " + dir + " -o " + dir + "/mine.obj --threshold 99", 1, "threshold");
@@ -81,7 +86,8 @@ TEST_CASE("cli: --help documents every subcommand", "[cli]") {
   for (const char* sub : {"fit", "mesh", "chart", "correspond", "eval", "eval-corr"})
     CHECK(r.output.find(sub) != std::string::npos);
   const Result f = run("fit --help");
-  for (const char* flag : {"--iters", "--points", "--gaussians", "--lr", "--seed", "--threads", "--w-6d", "--w-2d",
-                           "--w-cycle", "--w-iso", "--w-rep", "--no-chart", "--resume", "--table-row"})
+  for (const char* flag :
+       {"--iters", "--points", "--gaussians", "--lr", "--seed", "--threads", "--w-6d", "--w-2d",
+        "--w-cycle", "--w-iso", "--w-rep", "--no-chart", "--resume", "--table-row"})
     CHECK(f.output.find(flag) != std::string::npos);
 }

@@ -1,13 +1,12 @@
 // The command line end to end on small settings: fit -> outputs -> mesh,
 // chart, eval; resume follows the uninterrupted trajectory; SIGKILL loses at
 // most one checkpoint interval and leaves a loadable checkpoint.
-#include <catch2/catch.hpp>
-
-#include <csignal>
-#include <thread>
+#include <tiny_obj_loader.h>
 #include <unistd.h>
 
-#include <tiny_obj_loader.h>
+#include <catch2/catch.hpp>
+#include <csignal>
+#include <thread>
 
 #include "io/geometry/builtin_shapes.h"
 #include "io/pictures/image.h"
@@ -18,7 +17,8 @@ using jsa::Index;
 namespace fs = std::filesystem;
 
 namespace {
-const std::string kSmall = " -K 200 -M 200 --width 16 --depth 2 --threads 1 --pool 5000 --mesh-resolution 32 -q";
+const std::string kSmall =
+    " -K 200 -M 200 --width 16 --depth 2 --threads 1 --pool 5000 --mesh-resolution 32 -q";
 
 // The loss columns of losses.csv, without the header.
 std::string loss_rows(const std::string& dir) {
@@ -32,10 +32,11 @@ TEST_CASE("cli: fit writes every output and the follow-up commands read them", "
   Result r = run("fit builtin:torus -o " + dir + " --iters 30" + kSmall);
   INFO(r.output);
   REQUIRE(r.code == 0);
-  for (const char* f : {"config.json", "losses.csv", "model.ckpt", "domain_mesh.obj", "domain_mesh.mtl",
-                        "domain_mesh_uv.json", "domain_mesh.png", "input_chart.obj", "input_chart_uv.json",
-                        "input_chart.png", "input_chart_layout.png", "domain.png", "losses.png",
-                        "jsatlas_texture.png"})
+  for (const char* f :
+       {"config.json", "losses.csv", "model.ckpt", "domain_mesh.obj", "domain_mesh.mtl",
+        "domain_mesh_uv.json", "domain_mesh.png", "input_chart.obj", "input_chart_uv.json",
+        "input_chart.png", "input_chart_layout.png", "domain.png", "losses.png",
+        "jsatlas_texture.png"})
     CHECK(fs::exists(dir + "/" + f));
   CHECK(count_lines(loss_rows(dir)) == 30);
   // The chart keeps the input's vertex count and face order.
@@ -80,7 +81,8 @@ TEST_CASE("cli: SIGKILL at a random moment leaves a loadable checkpoint", "[cli]
   // Kill in the middle of a run that checkpoints every 5 iterations (0.7 s after
   // its first checkpoint, however slow the machine or the build is).
   Result r = run("fit builtin:sphere -o " + dir + " --iters 100000 --checkpoint-every 5" + kSmall +
-                 " & pid=$!; while [ ! -f " + dir + "/model.ckpt ]; do sleep 0.02; done; sleep 0.7; "
+                 " & pid=$!; while [ ! -f " + dir +
+                 "/model.ckpt ]; do sleep 0.02; done; sleep 0.7; "
                  "kill -KILL $pid; wait $pid");
   REQUIRE(fs::exists(dir + "/model.ckpt"));
   // No temp files left half-written next to it that could be mistaken for results,
@@ -93,22 +95,26 @@ TEST_CASE("cli: SIGKILL at a random moment leaves a loadable checkpoint", "[cli]
   CHECK(done > 0);
 }
 
-TEST_CASE("cli: the chart OBJ reads back in tinyobjloader with one vt per input vertex, faces in order",
-          "[cli]") {
+TEST_CASE(
+    "cli: the chart OBJ reads back in tinyobjloader with one vt per input vertex, faces in order",
+    "[cli]") {
   const std::string dir = fresh_dir("objback");
   REQUIRE(run("fit builtin:torus -o " + dir + " --iters 10" + kSmall).code == 0);
   const jsa::Mesh input = jsa::builtin_shape("torus");
   for (const bool split : {false, true}) {
     const std::string path = split ? dir + "/split.obj" : dir + "/input_chart.obj";
-    if (split) REQUIRE(run("chart " + dir + " -o " + path + " --split-cuts --torn-ratio 2 -q").code == 0);
+    if (split)
+      REQUIRE(run("chart " + dir + " -o " + path + " --split-cuts --torn-ratio 2 -q").code == 0);
     tinyobj::ObjReader reader;
     REQUIRE(reader.ParseFromFile(path));
     const auto& attrib = reader.GetAttrib();
     REQUIRE(reader.GetShapes().size() == 1);
     const auto& indices = reader.GetShapes()[0].mesh.indices;
     CHECK(attrib.vertices.size() == size_t(3 * input.vertices.rows()));
-    if (!split) CHECK(attrib.texcoords.size() == size_t(2 * input.vertices.rows()));
-    else CHECK(attrib.texcoords.size() >= size_t(2 * input.vertices.rows()));
+    if (!split)
+      CHECK(attrib.texcoords.size() == size_t(2 * input.vertices.rows()));
+    else
+      CHECK(attrib.texcoords.size() >= size_t(2 * input.vertices.rows()));
     REQUIRE(indices.size() == size_t(3 * input.faces.rows()));
     bool same_order = true, uv_in_range = true;
     for (size_t k = 0; k < indices.size(); ++k) {
@@ -121,7 +127,8 @@ TEST_CASE("cli: the chart OBJ reads back in tinyobjloader with one vt per input 
   }
 }
 
-TEST_CASE("cli: a collection with a shape batch and a user texture writes the texture transfer", "[cli]") {
+TEST_CASE("cli: a collection with a shape batch and a user texture writes the texture transfer",
+          "[cli]") {
   const std::string dir = fresh_dir("texture");
   const std::string texture = dir + "/../jsatlas_test_paint_" + std::to_string(::getpid()) + ".png";
   jsa::write_png(texture, jsa::checkerboard(64, 8));
@@ -140,7 +147,8 @@ TEST_CASE("cli: a collection with a shape batch and a user texture writes the te
   }
   // A texture that cannot be read stops the fit before any training.
   const std::string other = fresh_dir("texture_bad");
-  r = run("fit builtin:sphere -o " + other + " --iters 5 --texture " + dir + "/config.json" + kSmall);
+  r = run("fit builtin:sphere -o " + other + " --iters 5 --texture " + dir + "/config.json" +
+          kSmall);
   CHECK(r.code == 1);
   CHECK(r.output.find("config.json: not a readable image") != std::string::npos);
   CHECK(!fs::exists(other + "/model.ckpt"));
@@ -150,7 +158,8 @@ TEST_CASE("cli: a collection with a shape batch and a user texture writes the te
 TEST_CASE("cli: moving flipped Gaussians is reported and saved", "[cli]") {
   // The inside-out sphere: the random start's sheet faces the wrong way somewhere.
   const std::string dir = fresh_dir("reseed");
-  Result r = run("fit builtin:sphere -o " + dir + " --iters 40 --reseed 10" + kSmall.substr(0, kSmall.size() - 3));
+  Result r = run("fit builtin:sphere -o " + dir + " --iters 40 --reseed 10" +
+                 kSmall.substr(0, kSmall.size() - 3));
   INFO(r.output);
   REQUIRE(r.code == 0);
   CHECK(r.output.find("Gaussians off back-facing flaps") != std::string::npos);
@@ -170,7 +179,8 @@ TEST_CASE("cli: the dense surface flag is saved, and its negation turns it off",
   CHECK(run("fit builtin:sphere -o " + dir + "_bad --dense-surface=maybe" + kSmall).code == 2);
 }
 
-TEST_CASE("cli: the starting wrap is reported, and Ctrl-C during it writes no checkpoint", "[cli]") {
+TEST_CASE("cli: the starting wrap is reported, and Ctrl-C during it writes no checkpoint",
+          "[cli]") {
   const std::string dir = fresh_dir("wrap");
   Result r = run("fit builtin:capsule -o " + dir + " --iters 5 --wrap 30" +
                  kSmall.substr(0, kSmall.size() - 3));  // without -q: the progress lines
@@ -180,8 +190,10 @@ TEST_CASE("cli: the starting wrap is reported, and Ctrl-C during it writes no ch
   CHECK(read_text(dir + "/config.json").find("\"wrap_steps\": 30") != std::string::npos);
   // A wrap that would take hours, interrupted once the run has started.
   const std::string stopped = fresh_dir("wrap_interrupted");
-  r = run("fit builtin:capsule -o " + stopped + " --iters 5 --wrap 1000000" + kSmall + " 2>&1 & pid=$!; while [ ! -f " +
-          stopped + "/config.json ]; do sleep 0.01; done; sleep 0.3; kill -INT $pid; wait $pid; echo exit=$?");
+  r = run(
+      "fit builtin:capsule -o " + stopped + " --iters 5 --wrap 1000000" + kSmall +
+      " 2>&1 & pid=$!; while [ ! -f " + stopped +
+      "/config.json ]; do sleep 0.01; done; sleep 0.3; kill -INT $pid; wait $pid; echo exit=$?");
   INFO(r.output);
   CHECK(r.output.find("exit=130") != std::string::npos);
   CHECK(r.output.find("interrupted while wrapping") != std::string::npos);

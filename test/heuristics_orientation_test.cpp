@@ -2,7 +2,6 @@
 // an exact reparametrization (same surface, negated normals, psi still its
 // inverse), and the trainer uses it to turn an inside-out atlas right side out.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
 #include "engine/ops.h"
@@ -18,8 +17,8 @@ namespace {
 AtlasOptions small_atlas() { return test_support::small_atlas(12); }
 }  // namespace
 
-
-TEST_CASE("mirror_domain: the same surface with negated normals; psi stays consistent", "[orientation]") {
+TEST_CASE("mirror_domain: the same surface with negated normals; psi stays consistent",
+          "[orientation]") {
   Atlas<double> atlas(small_atlas());
   Rng init(3);
   atlas.initialize(init);
@@ -32,8 +31,8 @@ TEST_CASE("mirror_domain: the same surface with negated normals; psi stays consi
   Block<double> swapped = uv;
   swapped.col(0).swap(swapped.col(1));
 
-  auto surface = [&](const Block<double>& at, Block<double>& points, Block<double>& normals, Block<double>& chart,
-                     std::vector<double>& density) {
+  auto surface = [&](const Block<double>& at, Block<double>& points, Block<double>& normals,
+                     Block<double>& chart, std::vector<double>& density) {
     Tape<double> t;
     SurfacePoints s = atlas.phi.evaluate(t, atlas.params, t.constant(at), true);
     points = t.value(s.points);
@@ -50,12 +49,13 @@ TEST_CASE("mirror_domain: the same surface with negated normals; psi stays consi
   mirror_domain(atlas, {&moment});
   surface(swapped, p1, n1, c1, d1);
 
-  CHECK((p1 - p0).cwiseAbs().maxCoeff() < 1e-12);        // phi'(v, u) = phi(u, v)
-  CHECK((n1 + n0).cwiseAbs().maxCoeff() < 1e-12);        // n' = -n
-  CHECK(n0.cwiseAbs().maxCoeff() > 1e-3);                // (and the normals are not zero)
+  CHECK((p1 - p0).cwiseAbs().maxCoeff() < 1e-12);                // phi'(v, u) = phi(u, v)
+  CHECK((n1 + n0).cwiseAbs().maxCoeff() < 1e-12);                // n' = -n
+  CHECK(n0.cwiseAbs().maxCoeff() > 1e-3);                        // (and the normals are not zero)
   CHECK((c1.col(0) - c0.col(1)).cwiseAbs().maxCoeff() < 1e-12);  // psi' = swap(psi)
   CHECK((c1.col(1) - c0.col(0)).cwiseAbs().maxCoeff() < 1e-12);
-  for (size_t i = 0; i < d0.size(); ++i) CHECK(d1[i] == Approx(d0[i]).epsilon(1e-12));  // P' = mirrored P
+  for (size_t i = 0; i < d0.size(); ++i)
+    CHECK(d1[i] == Approx(d0[i]).epsilon(1e-12));  // P' = mirrored P
   CHECK(moment != moment_before);  // the aligned buffer moved with the parameters...
   mirror_domain(atlas, {&moment});
   CHECK(moment == moment_before);  // ...and mirroring twice is the identity

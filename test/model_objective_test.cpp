@@ -2,7 +2,6 @@
 // psi) from one backward() against central differences of the whole objective,
 // for the full method and for each ablation row.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
 #include "engine/ops.h"
@@ -21,8 +20,8 @@ Block<double> random_targets(Index n, double alpha, uint64_t seed) {
   return test_support::sphere_pool(n, seed, alpha);
 }
 
-double objective_value(Atlas<double>& atlas, const std::vector<Block<double>>& targets, const Components& c,
-                       Tape<double>& tape, bool backward) {
+double objective_value(Atlas<double>& atlas, const std::vector<Block<double>>& targets,
+                       const Components& c, Tape<double>& tape, bool backward) {
   Rng rng(99);  // the same draws every evaluation: the objective is a fixed function
   tape.clear();
   ObjectiveOptions o;
@@ -42,8 +41,9 @@ double objective_value(Atlas<double>& atlas, const std::vector<Block<double>>& t
 // matches and ReLU patterns unchanged (random inputs are in general position,
 // so ties and kinks are measure-zero events).
 template <class Value>
-double worst_central_difference(Atlas<double>& atlas, const std::vector<double>& analytic, size_t first,
-                                size_t end, size_t stride, Value value, int& checked) {
+double worst_central_difference(Atlas<double>& atlas, const std::vector<double>& analytic,
+                                size_t first, size_t end, size_t stride, Value value,
+                                int& checked) {
   double worst = 0;
   for (size_t i = first; i < end; i += stride) {
     double& x = atlas.params.values()[i];
@@ -79,15 +79,17 @@ TEST_CASE("objective: gradients of L_single match central differences", "[object
     // Central differences on a fixed subset of entries (every 7th).
     int checked = 0;
     const double worst = worst_central_difference(
-        atlas, analytic, 0, analytic.size(), 7, [&]() { return objective_value(atlas, targets, c, tape, false); },
-        checked);
+        atlas, analytic, 0, analytic.size(), 7,
+        [&]() { return objective_value(atlas, targets, c, tape, false); }, checked);
     INFO("Table 1 row " << row << ": " << checked << " entries, worst error/tolerance " << worst);
     CHECK(checked > 30);
     CHECK(worst <= 1.0);
   }
 }
 
-TEST_CASE("objective: gradients of L_full for a collection (latent codes) match central differences", "[objective]") {
+TEST_CASE(
+    "objective: gradients of L_full for a collection (latent codes) match central differences",
+    "[objective]") {
   AtlasOptions ao = small_atlas_options();
   ao.shapes = 2;
   ao.code_size = 4;
@@ -101,7 +103,8 @@ TEST_CASE("objective: gradients of L_full for a collection (latent codes) match 
     auto c = atlas.params.value(atlas.params.find(name));
     for (Index i = 0; i < c.size(); ++i) c.data()[i] = 0.3 * std::sin(1.0 + 3.0 * double(i));
   }
-  const std::vector<Block<double>> targets{random_targets(32, ao.alpha, 3), random_targets(32, ao.alpha, 4)};
+  const std::vector<Block<double>> targets{random_targets(32, ao.alpha, 3),
+                                           random_targets(32, ao.alpha, 4)};
   const Components c;
   Tape<double> tape;
   objective_value(atlas, targets, c, tape, true);
@@ -110,9 +113,10 @@ TEST_CASE("objective: gradients of L_full for a collection (latent codes) match 
   int checked = 0;
   for (const char* name : {"codes.phi", "codes.psi", "phi.wf", "psi.wf", "domain.mu", "phi.w0"}) {
     const auto& e = atlas.params.entry(atlas.params.find(name));
-    worst = std::max(worst, worst_central_difference(
-                                atlas, analytic, e.offset, e.offset + size_t(e.rows * e.cols), 3,
-                                [&]() { return objective_value(atlas, targets, c, tape, false); }, checked));
+    worst = std::max(
+        worst, worst_central_difference(
+                   atlas, analytic, e.offset, e.offset + size_t(e.rows * e.cols), 3,
+                   [&]() { return objective_value(atlas, targets, c, tape, false); }, checked));
   }
   INFO(checked << " entries, worst error/tolerance " << worst);
   CHECK(checked > 40);
@@ -146,7 +150,8 @@ TEST_CASE("objective: a batch of B of N shapes is their sum scaled by N / B", "[
   o.weights.code = 0;
   Tape<double> tape;
   Rng r1(11);
-  const double batch = tape.scalar(collection_objective(tape, atlas, {t2, t0}, 24, r1, o, nullptr, {2, 0}));
+  const double batch =
+      tape.scalar(collection_objective(tape, atlas, {t2, t0}, 24, r1, o, nullptr, {2, 0}));
   tape.clear();
   Rng r2(11);
   const double l2 = tape.scalar(single_shape_objective(tape, atlas, 2, t2, 24, r2, o, nullptr));
@@ -154,11 +159,13 @@ TEST_CASE("objective: a batch of B of N shapes is their sum scaled by N / B", "[
   CHECK(batch == Approx(1.5 * (l2 + l0)).epsilon(1e-12));
   tape.clear();
   Rng r3(11);
-  CHECK_THROWS_AS(collection_objective(tape, atlas, {t2, t0}, 24, r3, o, nullptr, {2, 3}), InternalError);
+  CHECK_THROWS_AS(collection_objective(tape, atlas, {t2, t0}, 24, r3, o, nullptr, {2, 3}),
+                  InternalError);
 }
 
-TEST_CASE("objective: dense L_6D equals Eq. 7 when the pool is the step's targets, and is differentiable",
-          "[objective]") {
+TEST_CASE(
+    "objective: dense L_6D equals Eq. 7 when the pool is the step's targets, and is differentiable",
+    "[objective]") {
   AtlasOptions ao = small_atlas_options();
   Atlas<double> atlas(ao);
   Rng init(12);
@@ -180,7 +187,8 @@ TEST_CASE("objective: dense L_6D equals Eq. 7 when the pool is the step's target
   const std::vector<double> g_same = run(same, same_terms);
   CHECK(same_terms.total == Approx(sparse_terms.total).epsilon(1e-12));
   double worst = 0;
-  for (size_t i = 0; i < g_sparse.size(); ++i) worst = std::max(worst, std::abs(g_sparse[i] - g_same[i]));
+  for (size_t i = 0; i < g_sparse.size(); ++i)
+    worst = std::max(worst, std::abs(g_sparse[i] - g_same[i]));
   CHECK(worst < 1e-12);
 
   // A pool 20 times denser on the same sphere: the x_P side finds closer matches.
@@ -188,17 +196,20 @@ TEST_CASE("objective: dense L_6D equals Eq. 7 when the pool is the step's target
   dense.emplace_back(random_targets(480, ao.alpha, 15));
   run(dense, dense_terms);
   CHECK(dense_terms.surface < sparse_terms.surface);
-  CHECK(dense_terms.chart == Approx(sparse_terms.chart).epsilon(1e-12));  // L_2D does not see the pool
+  CHECK(dense_terms.chart ==
+        Approx(sparse_terms.chart).epsilon(1e-12));  // L_2D does not see the pool
 
   // Central differences of the dense objective on every 7th parameter.
   const std::vector<double> analytic = run(dense, dense_terms);
   auto value = [&]() {
     Tape<double> tape;
     Rng rng(14);
-    return tape.scalar(collection_objective(tape, atlas, {targets}, 24, rng, o, nullptr, {}, dense));
+    return tape.scalar(
+        collection_objective(tape, atlas, {targets}, 24, rng, o, nullptr, {}, dense));
   };
   int checked = 0;
-  const double worst_fd = worst_central_difference(atlas, analytic, 0, analytic.size(), 7, value, checked);
+  const double worst_fd =
+      worst_central_difference(atlas, analytic, 0, analytic.size(), 7, value, checked);
   INFO(checked << " entries, worst error/tolerance " << worst_fd);
   CHECK(checked > 30);
   CHECK(worst_fd <= 1.0);

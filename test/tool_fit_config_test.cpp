@@ -34,8 +34,9 @@ TEST_CASE("fit config: the defaults round-trip through JSON", "[fit_config]") {
   CHECK(o.seed == jsa::FitOptions().seed);
 }
 
-TEST_CASE("fit config: the paper preset restores the paper's lambdas and keeps the run's own settings",
-          "[fit_config]") {
+TEST_CASE(
+    "fit config: the paper preset restores the paper's lambdas and keeps the run's own settings",
+    "[fit_config]") {
   jsa::FitOptions o;
   REQUIRE(o.weights.cycle == 0.1);  // the laptop default (docs/method.md, "lambda_cycle")
   o.iterations = 7;
@@ -54,7 +55,8 @@ TEST_CASE("fit config: the paper preset restores the paper's lambdas and keeps t
   CHECK_FALSE(o.dense_surface);
   CHECK(o.iterations == 7);
   CHECK(o.seed == 9);
-  CHECK(jsa::fit_options_to_json(jsa::paper_fit_options()).find("\"cycle\": 1.0") != std::string::npos);
+  CHECK(jsa::fit_options_to_json(jsa::paper_fit_options()).find("\"cycle\": 1.0") !=
+        std::string::npos);
 }
 
 TEST_CASE("fit config: settings added later read as what older runs did", "[fit_config]") {
@@ -75,8 +77,9 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   // A checkpoint written before these existed: no orientation check, no
   // batching, no wrap, ReLU.
   std::string old = jsa::fit_options_to_json(o, -1);
-  for (const std::string key : {"\"orient_every\":25,", "\"batch_shapes\":3,", ",\"wrap_steps\":40", ",\"reseed_every\":60", ",\"dense_surface\":true",
-                                "\"softplus_beta\":7.5,"}) {
+  for (const std::string key :
+       {"\"orient_every\":25,", "\"batch_shapes\":3,", ",\"wrap_steps\":40", ",\"reseed_every\":60",
+        ",\"dense_surface\":true", "\"softplus_beta\":7.5,"}) {
     const auto at = old.find(key);
     REQUIRE(at != std::string::npos);
     old.erase(at, key.size());
@@ -88,7 +91,8 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   CHECK(legacy.reseed_every == 0);
   CHECK(!legacy.dense_surface);
   CHECK(legacy.atlas.softplus_beta == 0);
-  CHECK(message_of(edited("\"batch_shapes\":0", "\"batch_shapes\":-2")) == "run/model.ckpt: sizes must be positive");
+  CHECK(message_of(edited("\"batch_shapes\":0", "\"batch_shapes\":-2")) ==
+        "run/model.ckpt: sizes must be positive");
 }
 
 TEST_CASE("fit config: malformed JSON is rejected naming the source and the field",
@@ -116,8 +120,9 @@ TEST_CASE("fuzz regressions: integer fields out of their type's range", "[fit_co
             .empty());  // a whole float is fine
 }
 
-TEST_CASE("fit config: sizes beyond the command line's limits are rejected before anything is allocated",
-          "[fit_config]") {
+TEST_CASE(
+    "fit config: sizes beyond the command line's limits are rejected before anything is allocated",
+    "[fit_config]") {
   jsa::FitOptions o;
   o.atlas.width = 1 << 20;
   const std::string text = jsa::fit_options_to_json(o);

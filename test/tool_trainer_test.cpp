@@ -1,7 +1,6 @@
 // The training loop: same seed -> same run; a resumed run follows the same
 // trajectory bit for bit; and a small atlas actually learns a sphere.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <sstream>
 
@@ -89,7 +88,8 @@ TEST_CASE("trainer: a small atlas learns the unit sphere", "[trainer]") {
   CHECK(final_6d < 0.1);
 }
 
-TEST_CASE("trainer: a NaN is caught, the last good state restored, and training goes on", "[trainer]") {
+TEST_CASE("trainer: a NaN is caught, the last good state restored, and training goes on",
+          "[trainer]") {
   const Block<double> pool = sphere_pool(4000, 1);
   Trainer t(small_options(), pool);
   for (int i = 0; i < 3; ++i) t.step();

@@ -5,8 +5,8 @@
 #include <limits>
 
 #include "engine/ops.h"
-#include "losses/chamfer.h"
 #include "io/geometry/nearest.h"
+#include "losses/chamfer.h"
 
 namespace jsa {
 

@@ -34,8 +34,8 @@
 namespace jsa {
 
 struct ReseedReport {
-  int flipped = 0;           // components moved
-  double back_facing = 0;    // fraction of all component samples facing away, before the move
+  int flipped = 0;         // components moved
+  double back_facing = 0;  // fraction of all component samples facing away, before the move
 };
 
 // targets: one block per shape in `shapes`, rows [x_S, alpha n_S] (any normal
@@ -43,6 +43,7 @@ struct ReseedReport {
 // (empty ones are skipped). samples_per_mean: S above.
 ReseedReport reseed_flipped_means(Atlas<float>& atlas, const std::vector<Block<float>>& targets,
                                   const std::vector<int>& shapes, Rng& rng,
-                                  const std::vector<std::vector<float>*>& moments, int samples_per_mean = 8);
+                                  const std::vector<std::vector<float>*>& moments,
+                                  int samples_per_mean = 8);
 
 }  // namespace jsa

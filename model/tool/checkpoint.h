@@ -15,10 +15,10 @@
 namespace jsa {
 
 struct CheckpointContents {
-  std::vector<std::string> inputs;           // what was fitted: paths or "builtin:NAME", one per shape
-  std::string settings_json;                 // fit_options_to_json of the run
-  std::vector<Normalization> normalizations; // input frame -> unit frame, one per shape
-  std::string state;                         // Trainer::save_state bytes
+  std::vector<std::string> inputs;  // what was fitted: paths or "builtin:NAME", one per shape
+  std::string settings_json;        // fit_options_to_json of the run
+  std::vector<Normalization> normalizations;  // input frame -> unit frame, one per shape
+  std::string state;                          // Trainer::save_state bytes
 };
 
 void write_checkpoint(const std::string& path, const std::vector<std::string>& inputs,
@@ -29,6 +29,7 @@ CheckpointContents read_checkpoint(const std::string& path);
 // Restores a trainer built from contents.settings_json.
 void restore_trainer(Trainer& trainer, const CheckpointContents& contents, const std::string& path);
 // The atlas alone (no optimiser), for the commands that use a finished run.
-std::unique_ptr<Atlas<float>> load_atlas(const CheckpointContents& contents, const std::string& path);
+std::unique_ptr<Atlas<float>> load_atlas(const CheckpointContents& contents,
+                                         const std::string& path);
 
 }  // namespace jsa

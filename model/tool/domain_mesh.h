@@ -19,16 +19,16 @@ struct TextureFrame {
 TextureFrame texture_frame(const Atlas<float>& atlas);
 
 struct DomainMeshOptions {
-  int resolution = 256;    // grid cells along the longer side of the domain's bounding box
+  int resolution = 256;     // grid cells along the longer side of the domain's bounding box
   double threshold = 0.05;  // keep P(x) >= threshold * (median of P at the means); measured on
-                           // teddy_1: 0.3 kept 93% of the mass, 0.05 kept 99.5% and the legs
+                            // teddy_1: 0.3 kept 93% of the mass, 0.05 kept 99.5% and the legs
 };
 
 struct DomainMesh {
-  Block<double> uv;                                          // V x 2 domain coordinates
+  Block<double> uv;                                              // V x 2 domain coordinates
   Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor> faces;  // F x 3, counter-clockwise in uv
-  double level = 0;          // the absolute density threshold used
-  double mass_fraction = 0;  // share of P's mass where P >= level (grid estimate)
+  double level = 0;           // the absolute density threshold used
+  double mass_fraction = 0;   // share of P's mass where P >= level (grid estimate)
   Eigen::RowVector2d lo, hi;  // the grid's bounding box (vt = (uv - lo) / (hi - lo))
 };
 

@@ -3,9 +3,8 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <type_traits>
-
 #include <nlohmann/json.hpp>
+#include <type_traits>
 
 namespace jsa {
 
@@ -108,7 +107,8 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   field(a, "atlas.", "alpha", o.atlas.alpha);
   field(a, "atlas.", "shapes", o.atlas.shapes);
   field(a, "atlas.", "code_size", o.atlas.code_size);
-  if (a.contains("code_layer")) field(a, "atlas.", "code_layer", o.atlas.code_layer);  // later addition: absent = 0
+  if (a.contains("code_layer"))
+    field(a, "atlas.", "code_layer", o.atlas.code_layer);  // later addition: absent = 0
   o.atlas.softplus_beta = 0;  // later addition: absent = ReLU, what older runs used
   if (a.contains("softplus_beta")) field(a, "atlas.", "softplus_beta", o.atlas.softplus_beta);
   const json& w = j.contains("weights") ? j["weights"] : json();
@@ -146,15 +146,17 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   field(j, "", "pool", o.pool);
   field(j, "", "threads", o.threads);
   if (o.atlas.gaussians <= 0 || o.atlas.width <= 0 || o.atlas.hidden_layers < 0 || o.points <= 0 ||
-      o.atlas.shapes <= 0 || o.atlas.code_size <= 0 || o.pool <= 0 || o.threads < 0 || o.orient_every < 0 || o.batch_shapes < 0 || o.wrap_steps < 0 || o.reseed_every < 0 || o.atlas.code_layer < 0 || o.atlas.code_layer > 1 || !(o.lr > 0) ||
+      o.atlas.shapes <= 0 || o.atlas.code_size <= 0 || o.pool <= 0 || o.threads < 0 ||
+      o.orient_every < 0 || o.batch_shapes < 0 || o.wrap_steps < 0 || o.reseed_every < 0 ||
+      o.atlas.code_layer < 0 || o.atlas.code_layer > 1 || !(o.lr > 0) ||
       !(o.atlas.softplus_beta >= 0) || !std::isfinite(o.atlas.softplus_beta) ||
       !std::isfinite(o.lr))
     throw InputError(what + ": sizes must be positive");
   // The same bounds as the command line's, so a crafted file cannot make the
   // atlas allocate without limit.
   if (o.atlas.gaussians > 1000000 || o.atlas.width > 4096 || o.atlas.hidden_layers > 32 ||
-      o.atlas.code_size > 4096 || o.atlas.shapes > 100000 || o.points > 1000000 || o.pool > 10000000 ||
-      o.threads > 1024 || o.wrap_steps > 1000000)
+      o.atlas.code_size > 4096 || o.atlas.shapes > 100000 || o.points > 1000000 ||
+      o.pool > 10000000 || o.threads > 1024 || o.wrap_steps > 1000000)
     throw InputError(what + ": a size is beyond the command line's limits (corrupt settings?)");
   return o;
 }

@@ -7,7 +7,8 @@
 
 namespace jsa {
 
-static const char* kHeader = "iteration,lr,total,surface_6d,chart_2d,cycle_2d,cycle_6d,isometry,repulsion";
+static const char* kHeader =
+    "iteration,lr,total,surface_6d,chart_2d,cycle_2d,cycle_6d,isometry,repulsion";
 
 void write_loss_log(const std::string& path, const LossLog& log) {
   write_file_atomically(path, [&](std::ostream& out) {

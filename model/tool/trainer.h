@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "engine/adam.h"
-#include "model/objective.h"
 #include "model/heuristics/wrap.h"
+#include "model/objective.h"
 
 namespace jsa {
 
@@ -38,19 +38,19 @@ struct FitOptions {
     // input out with fewer flipped triangles (docs/method.md, "lambda_cycle").
     weights.cycle = 0.1;
   }
-  AtlasOptions atlas;          // K, network sizes, alpha
-  LossWeights weights;         // the lambdas of Eq. 5 (mean convention)
-  Components components;       // ablation switches (default: full method, row 11)
-  int64_t iterations = 5000;   // Adam steps
-  Index points = 2500;         // M: points sampled on P and on the shape per step
-  double lr = 1e-3;            // Adam learning rate
+  AtlasOptions atlas;                          // K, network sizes, alpha
+  LossWeights weights;                         // the lambdas of Eq. 5 (mean convention)
+  Components components;                       // ablation switches (default: full method, row 11)
+  int64_t iterations = 5000;                   // Adam steps
+  Index points = 2500;                         // M: points sampled on P and on the shape per step
+  double lr = 1e-3;                            // Adam learning rate
   std::vector<double> decay_at = {0.75, 0.9};  // fractions of `iterations` where lr *= decay
-  double decay = 0.1;          // step-decay factor
-  uint64_t seed = 1;           // every random draw derives from it
-  double repulsion_tolerance = 1e-7;  // cut-off error bound of L_rep
-  int max_faults = 5;          // NaN/Inf recoveries in a row before giving up
-  Index pool = 200000;         // surface samples drawn once per shape (the targets' pool)
-  int threads = 0;             // threads of the run (0: all); results depend on seed and threads
+  double decay = 0.1;                          // step-decay factor
+  uint64_t seed = 1;                           // every random draw derives from it
+  double repulsion_tolerance = 1e-7;           // cut-off error bound of L_rep
+  int max_faults = 5;                          // NaN/Inf recoveries in a row before giving up
+  Index pool = 200000;  // surface samples drawn once per shape (the targets' pool)
+  int threads = 0;      // threads of the run (0: all); results depend on seed and threads
   // Every this many iterations before the first decay point, choose the global
   // orientation of phi (model/heuristics/orientation.h); 0: never. Only with normals in the loss.
   int orient_every = 100;
@@ -101,7 +101,8 @@ struct NumericalFault : std::runtime_error {
   using std::runtime_error::runtime_error;
   NumericalFault(int faults_in_a_row, int64_t iteration)
       : std::runtime_error("training diverged: NaN/Inf " + std::to_string(faults_in_a_row) +
-                           " times in a row at iteration " + std::to_string(iteration) + " (try a smaller --lr)") {}
+                           " times in a row at iteration " + std::to_string(iteration) +
+                           " (try a smaller --lr)") {}
 };
 
 class Trainer {
@@ -122,7 +123,9 @@ class Trainer {
   WrapReport wrap(const std::function<bool()>& cancelled = {});
   double learning_rate() const;  // the schedule at the current iteration, times the fault scale
   int faults() const { return faults_total_; }
-  int mirrors() const { return mirrors_; }  // times the domain was mirrored (model/heuristics/orientation.h)
+  int mirrors() const {
+    return mirrors_;
+  }  // times the domain was mirrored (model/heuristics/orientation.h)
   int reseeded() const { return reseeded_; }  // Gaussians moved so far (model/heuristics/reseed.h)
   // Test hook: the next `count` attempts at `iteration` see a NaN loss.
   void inject_faults(int64_t iteration, int count) {
@@ -144,7 +147,7 @@ class Trainer {
 
  private:
   FitOptions options_;
-  std::vector<Block<float>> pools_;  // per shape P x 6, normals scaled by alpha
+  std::vector<Block<float>> pools_;            // per shape P x 6, normals scaled by alpha
   std::vector<NearestIndex<float>> surfaces_;  // per shape, over its pool (dense L_6D only)
   std::unique_ptr<Atlas<float>> atlas_;
   Adam<float> adam_;
