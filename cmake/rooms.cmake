@@ -1,4 +1,4 @@
-# The rooms of jsatlas and which rooms each one stands on (docs/README.md, "Rooms").
+# The rooms of jsatlas and which rooms each one stands on (docs/README.md, "the rooms").
 # One table, read by CMakeLists.txt (one static library per room, linked to the
 # rooms listed here) and by cmake/check_layering.cmake (an #include of a room
 # outside this list, direct or through the rooms it stands on, fails the build).
