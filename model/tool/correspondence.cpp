@@ -1,7 +1,7 @@
 #include "model/tool/correspondence.h"
 
-#include "io/geometry/vertex_normals.h"
 #include "io/geometry/nearest.h"
+#include "io/geometry/vertex_normals.h"
 #include "model/tool/chart_mesh.h"
 #include "model/tool/domain_mesh.h"
 #include "model/tool/evaluate.h"
@@ -39,7 +39,8 @@ Block<double> correspond(Atlas<float>& atlas, int from, int to, const Block<doub
 
 KeypointError keypoint_error(Atlas<float>& atlas, const std::vector<Mesh>& meshes,
                              const std::vector<Normalization>& frames,
-                             const std::vector<std::vector<int>>& keypoints, const CorrespondenceOptions& o,
+                             const std::vector<std::vector<int>>& keypoints,
+                             const CorrespondenceOptions& o,
                              const std::vector<double>& thresholds) {
   const CorrespondenceMap map = [&](int from, int to, const Block<double>& p,
                                     const Block<double>& n) {
@@ -53,12 +54,14 @@ KeypointError keypoint_error(const CorrespondenceMap& map, const std::vector<Mes
                              const std::vector<std::vector<int>>& keypoints,
                              const std::vector<double>& thresholds) {
   const size_t n = meshes.size();
-  JSA_CHECK(frames.size() == n && keypoints.size() == n, "one mesh, frame and keypoint list per shape");
+  JSA_CHECK(frames.size() == n && keypoints.size() == n,
+            "one mesh, frame and keypoint list per shape");
   const size_t k = keypoints[0].size();
   for (size_t i = 0; i < n; ++i)
     if (keypoints[i].size() != k)
-      throw InputError("keypoint files differ in length: shape 0 has " + std::to_string(k) + ", shape " +
-                       std::to_string(i) + " has " + std::to_string(keypoints[i].size()));
+      throw InputError("keypoint files differ in length: shape 0 has " + std::to_string(k) +
+                       ", shape " + std::to_string(i) + " has " +
+                       std::to_string(keypoints[i].size()));
   KeypointError e;
   e.thresholds = thresholds;
   e.within.assign(thresholds.size(), 0.0);

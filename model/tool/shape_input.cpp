@@ -1,8 +1,8 @@
 #include "model/tool/shape_input.h"
 
 #include "io/geometry/builtin_shapes.h"
-#include "io/mesh_io.h"
 #include "io/geometry/surface_sampling.h"
+#include "io/mesh_io.h"
 
 namespace jsa {
 
