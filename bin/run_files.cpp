@@ -60,7 +60,7 @@ void write_domain_mesh(Atlas<float>& atlas, const Normalization& normalization,
   Block<double> points, normals;
   evaluate_surface(atlas, dm.uv, points, normals, shape);
   out.vertices = normalization.from_unit(points);
-  out.normals = normals;
+  out.normals = normalization.normals_from_unit(normals);
   out.faces = dm.faces;
   const Block<double> vt = texture_frame(atlas).to_texture(dm.uv);
   write_obj(obj_path, out, &vt, write_material(obj_path, o.texture), "atlas");

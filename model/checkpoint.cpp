@@ -13,7 +13,9 @@ namespace jsa {
 namespace {
 
 constexpr char kMagic[12] = {'J', 'S', 'A', 'T', 'L', 'A', 'S', '-', 'C', 'K', 'P', 'T'};
-constexpr uint32_t kVersion = 1;
+// Version 2 adds each shape's rotation (io/normalization.h) after its centre and
+// scale; version 1 files are read with the identity.
+constexpr uint32_t kVersion = 2;
 
 uint64_t fnv1a(const char* p, size_t n) {
   uint64_t h = 1469598103934665603ull;
@@ -43,7 +45,9 @@ void write_checkpoint(const std::string& path, const std::vector<std::string>& i
   for (const std::string& input : inputs) put_string(body, input);
   put_string(body, fit_options_to_json(options, -1));
   for (const Normalization& n : normalizations) {
-    const double norm[4] = {n.center(0), n.center(1), n.center(2), n.scale};
+    double norm[13] = {n.center(0), n.center(1), n.center(2), n.scale};
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) norm[4 + 3 * r + c] = n.rotation(r, c);
     body.append(reinterpret_cast<const char*>(norm), sizeof norm);
   }
   std::ostringstream state;
@@ -82,8 +86,8 @@ CheckpointContents read_checkpoint(const std::string& path) {
   };
   uint32_t version = 0;
   take(&version, sizeof version);
-  if (version != kVersion)
-    throw InputError(path + ": checkpoint format " + std::to_string(version) + ", this build reads " +
+  if (version != kVersion && version != 1)
+    throw InputError(path + ": checkpoint format " + std::to_string(version) + ", this build reads 1 to " +
                      std::to_string(kVersion));
   CheckpointContents c;
   uint64_t count = 0;
@@ -92,12 +96,20 @@ CheckpointContents read_checkpoint(const std::string& path) {
   for (uint64_t i = 0; i < count; ++i) c.inputs.push_back(take_string());
   c.settings_json = take_string();
   for (uint64_t i = 0; i < count; ++i) {
-    double norm[4];
-    take(norm, sizeof norm);
+    double norm[13];
+    take(norm, sizeof(double) * (version == 1 ? 4 : 13));
     Normalization n;
     n.center = Eigen::RowVector3d(norm[0], norm[1], norm[2]);
     n.scale = norm[3];
     if (!(n.scale > 0) || !n.center.allFinite()) throw InputError(path + ": bad normalisation in checkpoint");
+    if (version >= 2) {
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) n.rotation(r, c) = norm[4 + 3 * r + c];
+      const bool rotation = n.rotation.allFinite() &&
+                            (n.rotation * n.rotation.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-6 &&
+                            n.rotation.determinant() > 0;
+      if (!rotation) throw InputError(path + ": bad rotation in checkpoint");
+    }
     c.normalizations.push_back(n);
   }
   c.state = take_string();

@@ -67,6 +67,24 @@ struct FitOptions {
   // L_6D's dense variant (losses/chamfer.h): phi6(x_P) is matched in the whole
   // pool instead of the step's M targets; the targets' direction is unchanged.
   bool dense_surface = true;
+  // Collections: before the joint training, fit shape 0 alone (the template)
+  // for this many steps at the base learning rate, then copy its codes to every
+  // shape, so that all shapes start from one surface and one layout of the
+  // domain (model/heuristics: "template start"). A template step costs about
+  // 1/N of a joint step. -1: chosen from template_share (the CLI times the
+  // steps under --minutes; otherwise share / (1 - share) * iterations * N).
+  int64_t template_steps = 0;
+  // Collections: turn every shape into the pose of the first before fitting
+  // (io/geometry/rigid_align.h, applied by the caller: model/shape_input.h).
+  bool align_poses = true;
+  // Staged objective: until this fraction of the iterations, train phi and P
+  // alone (no psi, no L_2D, no L_cycle; Table 1 row 9's objective), then the
+  // full method. 0: the full method from the start, as the paper.
+  double chart_from = 0;
+  // Collections: the latent codes' learning rate as a multiple of the networks'
+  // (a per-group rate: the codes' Adam steps are scaled by it). 1: one rate.
+  double code_lr_scale = 1;
+  double template_share = 0;  // share of the run's cost spent on the template (when template_steps < 0)
 };
 
 // `--preset paper`: the paper's configuration (Sec. 3, implementation details)
@@ -120,6 +138,17 @@ class Trainer {
   // has not run; step() calls it before the first iteration. A resumed run
   // (iteration > 0) never wraps.
   WrapReport wrap(const std::function<bool()>& cancelled = {});
+  // The template start (FitOptions::template_steps): `steps` more Adam steps on
+  // shape 0 alone at the base learning rate. Only before the first iteration of
+  // a collection; may be called several times. finish_template() then copies
+  // shape 0's codes (and their Adam moments) to every shape. step() runs both
+  // itself, with options().template_steps, if they have not run.
+  void train_template(int64_t steps, const std::function<bool()>& cancelled = {});
+  void finish_template();
+  int64_t template_done() const { return template_done_; }
+  // template_steps resolved from template_share for a run of `iterations` joint steps.
+  static int64_t template_steps_for(const FitOptions& o, int64_t iterations, int shapes);
+  void set_template_steps(int64_t n) { options_.template_steps = n; }
   double learning_rate() const;  // the schedule at the current iteration, times the fault scale
   int faults() const { return faults_total_; }
   int mirrors() const { return mirrors_; }  // times the domain was mirrored (model/orientation.h)
@@ -154,6 +183,7 @@ class Trainer {
   LossTerms last_;
   std::vector<Block<float>> targets_;  // per shape of the step's batch
   std::vector<int> batch_;             // the shapes of the step (all N without batching)
+  std::vector<int> batch_step_;        // the shapes of the last step taken (targets_ belong to them)
   // The last good state, refreshed every kSnapshotEvery iterations.
   static constexpr int64_t kSnapshotEvery = 50;
   std::vector<float> good_params_, good_m_, good_v_;
@@ -165,8 +195,12 @@ class Trainer {
   int mirrors_ = 0;
   int reseeded_ = 0;
   bool wrapped_ = false;
+  int64_t template_done_ = 0;      // template steps taken
+  bool template_finished_ = false;
   void take_snapshot();
-  void choose_orientation();
+  // One Adam step on the shapes of `batch` at rate lr; false if a NaN/Inf was caught.
+  bool train_on(const std::vector<int>& batch, double lr, int64_t counter);
+  void choose_orientation(int64_t counter, bool in_window);
   void reseed();
 };
 

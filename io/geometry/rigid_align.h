@@ -1,0 +1,48 @@
+// Rigid alignment of one point set onto another by a rotation about the origin
+// (both centred at their means, as the unit frame puts them): the pose step of a
+// collection (shapes stored in their authors' frames are turned into the frame
+// of the first shape before the shared atlas sees them; docs/collections.md).
+//
+//   1. principal axes of both sets (eigenvectors of the second moments);
+//   2. candidates: the rotations that carry one set of axes onto the other,
+//      x -> x V_m S V_f^T with S a diagonal of signs and det = +1 (4 candidates),
+//      and, when two eigenvalues are close (the axes are not defined), every
+//      order of those axes as well (up to 24: the rotations of a cube);
+//   3. each candidate refined by point-to-point ICP, rotation only (Kabsch on
+//      the nearest pairs of both directions);
+//   4. the refined candidate with the lowest symmetric Chamfer distance wins;
+//      ties keep the earlier candidate (the fixed order above, identity first).
+// Symmetric shapes: a mirror is never a candidate (det = +1), so a left/right
+// symmetric shape cannot come out reflected; a shape with a front/back or
+// top/bottom symmetry has two candidates of about the same Chamfer, and the
+// report gives the runner-up's score so the caller can tell (`margin`).
+#pragma once
+#include <cstdint>
+
+#include "engine/block.h"
+
+namespace jsa {
+
+struct RigidAlignOptions {
+  Index samples = 3000;        // points of each set used (the first rows; pools are random draws)
+  int icp_iterations = 40;     // ICP steps per candidate
+  double close_eigenvalues = 0.15;  // relative gap |l_a - l_b| / l_a under which axes a, b may swap
+};
+
+struct RigidAlignment {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // rows: moving x -> x * rotation ~ fixed
+  double chamfer = 0;          // symmetric Chamfer (mean squared distance, both ways) after ICP
+  double runner_up = 0;        // the best Chamfer of a candidate that ends > 10 degrees away
+  int candidates = 0;          // rotations tried
+  double angle_degrees() const;  // of `rotation`
+};
+
+// moving, fixed: N x 3 and M x 3 points (any N, M >= 4), centred at the origin.
+// Deterministic: no random draws, nearest neighbours with a fixed tie rule.
+RigidAlignment rigid_align(const Block<double>& moving, const Block<double>& fixed,
+                           const RigidAlignOptions& options = {});
+
+// The angle of a rotation matrix, in degrees (0 for the identity, 180 at most).
+double rotation_angle_degrees(const Eigen::Matrix3d& r);
+
+}  // namespace jsa
