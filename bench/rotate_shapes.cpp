@@ -12,6 +12,7 @@
 //     the angle between the rotation the fit found for each copy and the one
 //     it should have found, A_i^T R0_i A_0, where R0_i is what the fit of the
 //     unposed shapes found (identity without --reference).
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -50,7 +51,8 @@ std::string turned(const std::string& line, size_t skip, const Eigen::Matrix3d& 
   const Eigen::RowVector3d q = p * a + t;
   char buf[128];
   std::snprintf(buf, sizeof buf, "%.9g %.9g %.9g", q(0), q(1), q(2));
-  return line.substr(0, skip) + buf + rest;
+  const bool spaced = skip > 0 && std::isspace(static_cast<unsigned char>(line[skip - 1]));
+  return line.substr(0, skip) + (spaced ? "" : " ") + buf + rest;
 }
 
 void rotate_file(const fs::path& from, const fs::path& to, const Eigen::Matrix3d& a, const Eigen::RowVector3d& t,

@@ -76,7 +76,7 @@ RigidAlignment rigid_align(const Block<double>& moving_all, const Block<double>&
                            const RigidAlignOptions& o) {
   JSA_CHECK(moving_all.cols() == 3 && fixed_all.cols() == 3, "rigid_align takes N x 3 points");
   JSA_CHECK(moving_all.rows() >= 4 && fixed_all.rows() >= 4, "rigid_align needs at least 4 points per set");
-  JSA_CHECK(o.samples >= 4 && o.icp_iterations >= 0, "bad rigid_align options");
+  JSA_CHECK(o.samples >= 4 && o.icp_iterations >= 0 && o.final_iterations >= 0, "bad rigid_align options");
   const Block<double> moving = moving_all.topRows(std::min(o.samples, moving_all.rows()));
   const Block<double> fixed = fixed_all.topRows(std::min(o.samples, fixed_all.rows()));
   const NearestIndex<double> moving_index(moving), fixed_index(fixed);
@@ -112,25 +112,28 @@ RigidAlignment rigid_align(const Block<double>& moving_all, const Block<double>&
     }
   } while (std::next_permutation(perm.begin(), perm.end()));
 
-  std::vector<Eigen::Matrix3d> refined;
-  std::vector<double> scores;
-  for (const Eigen::Matrix3d& start : candidates) {
-    Eigen::Matrix3d r = start, next;
-    for (int k = 0; k < o.icp_iterations; ++k) {
+  auto icp = [&](Eigen::Matrix3d r, int iterations) {
+    Eigen::Matrix3d next;
+    for (int k = 0; k < iterations; ++k) {
       chamfer_and_update(sets, r, &next);
       const double change = (next - r).cwiseAbs().maxCoeff();
       r = next;
       if (change < 1e-10) break;
     }
-    refined.push_back(r);
-    scores.push_back(chamfer_and_update(sets, r, nullptr));
+    return r;
+  };
+  std::vector<Eigen::Matrix3d> refined;
+  std::vector<double> scores;
+  for (const Eigen::Matrix3d& start : candidates) {
+    refined.push_back(icp(start, o.icp_iterations));
+    scores.push_back(chamfer_and_update(sets, refined.back(), nullptr));
   }
   size_t best = 0;
   for (size_t c = 1; c < scores.size(); ++c)
     if (scores[c] < scores[best]) best = c;
   RigidAlignment out;
-  out.rotation = refined[best];
-  out.chamfer = scores[best];
+  out.rotation = icp(refined[best], o.final_iterations);
+  out.chamfer = chamfer_and_update(sets, out.rotation, nullptr);
   out.candidates = int(candidates.size());
   out.runner_up = -1;
   for (size_t c = 0; c < scores.size(); ++c) {

@@ -11,7 +11,8 @@
 //   3. each candidate refined by point-to-point ICP, rotation only (Kabsch on
 //      the nearest pairs of both directions);
 //   4. the refined candidate with the lowest symmetric Chamfer distance wins;
-//      ties keep the earlier candidate (the fixed order above, identity first).
+//      ties keep the earlier candidate (the fixed order above, identity first);
+//      it gets more ICP steps, until the rotation stops changing.
 // Symmetric shapes: a mirror is never a candidate (det = +1), so a left/right
 // symmetric shape cannot come out reflected; a shape with a front/back or
 // top/bottom symmetry has two candidates of about the same Chamfer, and the
@@ -26,6 +27,8 @@ namespace jsa {
 struct RigidAlignOptions {
   Index samples = 3000;        // points of each set used (the first rows; pools are random draws)
   int icp_iterations = 40;     // ICP steps per candidate
+  int final_iterations = 500;  // more ICP steps for the winner (point-to-point ICP slides slowly
+                               // along directions a near-symmetric shape hardly pins)
   double close_eigenvalues = 0.15;  // relative gap |l_a - l_b| / l_a under which axes a, b may swap
 };
 
