@@ -12,18 +12,17 @@
 //     the angle between the rotation the fit found for each copy and the one
 //     it should have found, A_i^T R0_i A_0, where R0_i is what the fit of the
 //     unposed shapes found (identity without --reference).
+#include <CLI/CLI.hpp>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
 #include "engine/block.h"
 #include "engine/rng.h"
@@ -42,7 +41,8 @@ Eigen::Matrix3d random_rotation(Rng& rng) {
   return q.toRotationMatrix();
 }
 
-std::string turned(const std::string& line, size_t skip, const Eigen::Matrix3d& a, const Eigen::RowVector3d& t) {
+std::string turned(const std::string& line, size_t skip, const Eigen::Matrix3d& a,
+                   const Eigen::RowVector3d& t) {
   std::istringstream in(line.substr(skip));
   Eigen::RowVector3d p;
   if (!(in >> p(0) >> p(1) >> p(2))) return line;
@@ -55,8 +55,8 @@ std::string turned(const std::string& line, size_t skip, const Eigen::Matrix3d& 
   return line.substr(0, skip) + (spaced ? "" : " ") + buf + rest;
 }
 
-void rotate_file(const fs::path& from, const fs::path& to, const Eigen::Matrix3d& a, const Eigen::RowVector3d& t,
-                 bool vts) {
+void rotate_file(const fs::path& from, const fs::path& to, const Eigen::Matrix3d& a,
+                 const Eigen::RowVector3d& t, bool vts) {
   std::ifstream in(from);
   if (!in) throw std::runtime_error(from.string() + ": cannot open");
   std::ostringstream out;
@@ -89,7 +89,8 @@ Eigen::Matrix3d matrix_of(const nlohmann::json& m) {
   return r;
 }
 
-std::vector<Eigen::Matrix3d> read_rotations(const std::string& path, const char* list, const char* key) {
+std::vector<Eigen::Matrix3d> read_rotations(const std::string& path, const char* list,
+                                            const char* key) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open");
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -130,11 +131,15 @@ int main(int argc, char** argv) {
         if (fs::exists(vts)) rotate_file(vts, fs::path(out_dir) / vts.filename(), a, t, true);
         nlohmann::json m = nlohmann::json::array();
         for (int r = 0; r < 3; ++r) m.push_back({a(r, 0), a(r, 1), a(r, 2)});
-        list.push_back({{"input", inputs[i]}, {"rotation", m}, {"angle_degrees", jsa::rotation_angle_degrees(a)},
+        list.push_back({{"input", inputs[i]},
+                        {"rotation", m},
+                        {"angle_degrees", jsa::rotation_angle_degrees(a)},
                         {"offset", {t(0), t(1), t(2)}}});
-        std::printf("%s: turned by %.1f deg\n", obj.filename().c_str(), jsa::rotation_angle_degrees(a));
+        std::printf("%s: turned by %.1f deg\n", obj.filename().c_str(),
+                    jsa::rotation_angle_degrees(a));
       }
-      const nlohmann::json j = {{"seed", seed}, {"convention", "rows: x' = x * rotation + offset"}, {"shapes", list}};
+      const nlohmann::json j = {
+          {"seed", seed}, {"convention", "rows: x' = x * rotation + offset"}, {"shapes", list}};
       jsa::write_file_atomically((fs::path(out_dir) / "applied_rotations.json").string(),
                                  [&](std::ostream& f) { f << j.dump(2) << "\n"; });
     } else {
@@ -142,7 +147,8 @@ int main(int argc, char** argv) {
       const auto r = read_rotations(found, "shapes", "rotation");
       std::vector<Eigen::Matrix3d> r0(r.size(), Eigen::Matrix3d::Identity());
       if (!reference.empty()) r0 = read_rotations(reference, "shapes", "rotation");
-      if (a.size() != r.size() || r0.size() != r.size()) throw std::runtime_error("shape counts differ");
+      if (a.size() != r.size() || r0.size() != r.size())
+        throw std::runtime_error("shape counts differ");
       double sum = 0, worst = 0;
       for (size_t i = 1; i < r.size(); ++i) {
         const Eigen::Matrix3d expected = a[i].transpose() * r0[i] * a[0];

@@ -9,10 +9,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <vector>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
+#include <sstream>
+#include <vector>
 
 #include "bin/commands.h"
 #include "bin/run_files.h"
@@ -49,8 +48,10 @@ struct FitArgs {
 std::string format_duration(double seconds) {
   char buf[32];
   const int s = int(seconds + 0.5);
-  if (s >= 3600) std::snprintf(buf, sizeof buf, "%dh%02dm", s / 3600, (s / 60) % 60);
-  else std::snprintf(buf, sizeof buf, "%dm%02ds", s / 60, s % 60);
+  if (s >= 3600)
+    std::snprintf(buf, sizeof buf, "%dh%02dm", s / 3600, (s / 60) % 60);
+  else
+    std::snprintf(buf, sizeof buf, "%dm%02ds", s / 60, s % 60);
   return buf;
 }
 
@@ -76,10 +77,13 @@ void run_fit(FitArgs& a) {
     o = fit_options_from_json(resumed.settings_json, a.resume + "/model.ckpt");
     inputs = resumed.inputs;
   } else {
-    if (inputs.empty()) throw InputError("fit: give an INPUT (a mesh, a point cloud or builtin:NAME) or --resume DIR");
+    if (inputs.empty())
+      throw InputError(
+          "fit: give an INPUT (a mesh, a point cloud or builtin:NAME) or --resume DIR");
     if (a.out_dir.empty()) throw InputError("fit: give an output directory with -o DIR");
     if (!a.preset.empty()) {
-      if (a.preset != "paper") throw InputError("--preset: unknown preset '" + a.preset + "' (known: paper)");
+      if (a.preset != "paper")
+        throw InputError("--preset: unknown preset '" + a.preset + "' (known: paper)");
       apply_paper_preset(o);
     }
     if (a.table_row) o.components = Components::table_row(a.table_row);
@@ -91,7 +95,8 @@ void run_fit(FitArgs& a) {
   }
   if (a.threads >= 0) o.threads = a.threads;
   set_threads(o.threads);
-  if (!a.texture.empty()) (void)read_image(a.texture);  // a bad texture fails now, not after training
+  if (!a.texture.empty())
+    (void)read_image(a.texture);  // a bad texture fails now, not after training
 
   // Each shape, a fixed pool of surface samples, and its unit frame (Sec. 4 data).
   std::vector<RunInput> shapes;
@@ -119,8 +124,11 @@ void run_fit(FitArgs& a) {
     poses = align_to_first(shapes);
     if (!a.quiet) {
       std::cerr << "fit: poses aligned to shape 0 in "
-                << format_duration(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()) << ":";
-      for (size_t i = 1; i < poses.size(); ++i) std::fprintf(stderr, " %zu: %.1f deg;", i, poses[i].angle_degrees());
+                << format_duration(
+                       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count())
+                << ":";
+      for (size_t i = 1; i < poses.size(); ++i)
+        std::fprintf(stderr, " %zu: %.1f deg;", i, poses[i].angle_degrees());
       std::cerr << "\n";
     }
   }
@@ -135,21 +143,28 @@ void run_fit(FitArgs& a) {
     for (size_t i = 0; i < inputs.size(); ++i) {
       nlohmann::json m = nlohmann::json::array();
       for (int row = 0; row < 3; ++row)
-        m.push_back({poses[i].rotation(row, 0), poses[i].rotation(row, 1), poses[i].rotation(row, 2)});
-      nlohmann::json e = {{"input", inputs[i]}, {"rotation", m}, {"angle_degrees", poses[i].angle_degrees()}};
+        m.push_back(
+            {poses[i].rotation(row, 0), poses[i].rotation(row, 1), poses[i].rotation(row, 2)});
+      nlohmann::json e = {
+          {"input", inputs[i]}, {"rotation", m}, {"angle_degrees", poses[i].angle_degrees()}};
       if (i > 0 && !resuming && o.align_poses) {
         e["chamfer"] = poses[i].chamfer;
         e["runner_up_chamfer"] = poses[i].runner_up;
         e["candidates"] = poses[i].candidates;
+        e["input_pose_chamfer"] = poses[i].input_chamfer;
+        e["kept_input_pose"] = poses[i].kept_input;
       }
       r.push_back(e);
     }
     return r;
   };
   if (inputs.size() > 1) {
-    const nlohmann::json r = {{"convention", "unit-frame rows: x_unit = ((x_input - center) / scale) * rotation; shape 0 is the reference"},
+    const nlohmann::json r = {{"convention",
+                               "unit-frame rows: x_unit = ((x_input - center) / scale) * rotation; "
+                               "shape 0 is the reference"},
                               {"shapes", rotations_json()}};
-    write_file_atomically(dir + "/rotations.json", [&](std::ostream& out) { out << r.dump(2) << "\n"; });
+    write_file_atomically(dir + "/rotations.json",
+                          [&](std::ostream& out) { out << r.dump(2) << "\n"; });
   }
 
   Trainer trainer(o, pools);
@@ -159,19 +174,22 @@ void run_fit(FitArgs& a) {
     log = read_loss_log(dir + "/losses.csv", trainer.iteration());
   }
   if (!a.quiet)
-    std::cerr << "fit: " << (inputs.size() == 1 ? inputs[0] : std::to_string(inputs.size()) + " shapes") << " -> " << dir << "  (" << o.iterations << " iterations, M = " << o.points
-              << ", K = " << o.atlas.gaussians << ", MLP " << o.atlas.hidden_layers << "x" << o.atlas.width
-              << ", " << max_threads() << " threads" << (resuming ? ", resumed at " + std::to_string(trainer.iteration()) : std::string()) << ")\n";
+    std::cerr << "fit: "
+              << (inputs.size() == 1 ? inputs[0] : std::to_string(inputs.size()) + " shapes")
+              << " -> " << dir << "  (" << o.iterations << " iterations, M = " << o.points
+              << ", K = " << o.atlas.gaussians << ", MLP " << o.atlas.hidden_layers << "x"
+              << o.atlas.width << ", " << max_threads() << " threads"
+              << (resuming ? ", resumed at " + std::to_string(trainer.iteration()) : std::string())
+              << ")\n";
 
   auto write_config = [&]() {
-  write_file_atomically(dir + "/config.json", [&](std::ostream& out) {
+    write_file_atomically(dir + "/config.json", [&](std::ostream& out) {
       out << "{\n\"inputs\": [";
       for (size_t i = 0; i < inputs.size(); ++i) out << (i ? ", " : "") << json_quote(inputs[i]);
       out << "],\n\"settings\": " << fit_options_to_json(o);
       if (inputs.size() > 1) out << ",\n\"rotations\": " << rotations_json().dump();
       out << "\n}\n";
     });
-  
   };
   write_config();
   auto save = [&]() {
@@ -193,11 +211,13 @@ void run_fit(FitArgs& a) {
       throw ExitCode{130};
     }
     if (!a.quiet)
-      std::cerr << "fit: phi and psi wrapped around the shape's ellipsoid (" << o.wrap_steps << " steps, "
-                << format_duration(wrap_seconds) << "; RMS error phi " << w.phi_error << ", psi " << w.psi_error << ")\n";
+      std::cerr << "fit: phi and psi wrapped around the shape's ellipsoid (" << o.wrap_steps
+                << " steps, " << format_duration(wrap_seconds) << "; RMS error phi " << w.phi_error
+                << ", psi " << w.psi_error << ")\n";
   }
   const bool collection = inputs.size() > 1;
-  if (!resuming && collection && (o.template_steps > 0 || (o.template_steps < 0 && o.template_share > 0))) {
+  if (!resuming && collection &&
+      (o.template_steps > 0 || (o.template_steps < 0 && o.template_share > 0))) {
     // The template start (FitOptions::template_steps): shape 0 alone, then its
     // codes copied to every shape. Under --minutes its length is the share of
     // the budget, timed on its own steps (a fifth of a joint step for N = 4).
@@ -216,7 +236,8 @@ void run_fit(FitArgs& a) {
     }
     trainer.train_template(steps - trainer.template_done(), cancelled);
     if (g_signal) {
-      std::cerr << "fit: interrupted while fitting the template (before training); no checkpoint written\n";
+      std::cerr << "fit: interrupted while fitting the template (before training); no checkpoint "
+                   "written\n";
       throw ExitCode{130};
     }
     trainer.finish_template();
@@ -226,7 +247,8 @@ void run_fit(FitArgs& a) {
     wrap_seconds += seconds;
     if (!a.quiet)
       std::cerr << "fit: template start: shape 0 alone for " << o.template_steps << " steps ("
-                << format_duration(seconds) << ", L " << trainer.last().total << "), its codes copied to every shape\n";
+                << format_duration(seconds) << ", L " << trainer.last().total
+                << "), its codes copied to every shape\n";
   }
   const auto start = clock::now();
   auto last_print = start;
@@ -243,12 +265,15 @@ void run_fit(FitArgs& a) {
     if (!sized && trainer.iteration() - first == warmup + probe) {
       const auto now = clock::now();
       const double per = std::chrono::duration<double>(now - probe_start).count() / double(probe);
-      const double left = a.minutes * 60.0 - wrap_seconds - std::chrono::duration<double>(now - start).count();
+      const double left =
+          a.minutes * 60.0 - wrap_seconds - std::chrono::duration<double>(now - start).count();
       const int64_t n = warmup + probe + std::max<int64_t>(1, int64_t(left / per * 0.97));
       trainer.set_iterations(n);
       o.iterations = n;
       sized = true;
-      if (!a.quiet) std::cerr << "fit: " << a.minutes << " min at " << per * 1e3 << " ms/iteration -> " << n << " iterations\n";
+      if (!a.quiet)
+        std::cerr << "fit: " << a.minutes << " min at " << per * 1e3 << " ms/iteration -> " << n
+                  << " iterations\n";
     }
     if (trainer.finished()) continue;
     const int64_t before = trainer.iteration();
@@ -257,30 +282,39 @@ void run_fit(FitArgs& a) {
       trainer.step();
     } catch (const NumericalFault& e) {
       save();  // the trainer is back at its last good state
-      throw InputError(std::string("fit: ") + e.what() + "; last good state saved in " + dir + "/model.ckpt");
+      throw InputError(std::string("fit: ") + e.what() + "; last good state saved in " + dir +
+                       "/model.ckpt");
     }
     if (trainer.iteration() == before) {
-      std::fprintf(stderr, "  it %6lld: NaN/Inf caught, restored the last good state, learning rate now %.2e\n",
-                   (long long)before, trainer.learning_rate());
+      std::fprintf(
+          stderr,
+          "  it %6lld: NaN/Inf caught, restored the last good state, learning rate now %.2e\n",
+          (long long)before, trainer.learning_rate());
       continue;
     }
     log.rows.push_back({trainer.iteration(), trainer.learning_rate(), trainer.last()});
     if (trainer.mirrors() != mirrors && !a.quiet)
-      std::fprintf(stderr, "  it %6lld: most normals faced inward; mirrored the domain (u, v) -> (v, u)\n",
+      std::fprintf(stderr,
+                   "  it %6lld: most normals faced inward; mirrored the domain (u, v) -> (v, u)\n",
                    (long long)trainer.iteration());
     if (trainer.reseeded() != reseeded && !a.quiet)
-      std::fprintf(stderr, "  it %6lld: moved %d Gaussians off back-facing flaps\n", (long long)trainer.iteration(),
-                   trainer.reseeded() - reseeded);
+      std::fprintf(stderr, "  it %6lld: moved %d Gaussians off back-facing flaps\n",
+                   (long long)trainer.iteration(), trainer.reseeded() - reseeded);
     const auto now = clock::now();
     const double elapsed = std::chrono::duration<double>(now - start).count();
-    if (!a.quiet && (std::chrono::duration<double>(now - last_print).count() > 2.0 || trainer.finished())) {
+    if (!a.quiet &&
+        (std::chrono::duration<double>(now - last_print).count() > 2.0 || trainer.finished())) {
       last_print = now;
       const double rate = double(trainer.iteration() - first) / std::max(1e-9, elapsed);
       const LossTerms& l = trainer.last();
-      std::fprintf(stderr, "  it %6lld/%lld  %5.1f it/s  ETA %s  L %.3e  6D %.3e  2D %.3e  cyc %.2e/%.2e  iso %.3f  rep %.3e\n",
-                   (long long)trainer.iteration(), (long long)o.iterations, rate,
-                   format_duration(double(o.iterations - trainer.iteration()) / std::max(rate, 1e-9)).c_str(),
-                   l.total, l.surface, l.chart, l.cycle_2d, l.cycle_6d, l.isometry, l.repulsion);
+      std::fprintf(
+          stderr,
+          "  it %6lld/%lld  %5.1f it/s  ETA %s  L %.3e  6D %.3e  2D %.3e  cyc %.2e/%.2e  iso %.3f  "
+          "rep %.3e\n",
+          (long long)trainer.iteration(), (long long)o.iterations, rate,
+          format_duration(double(o.iterations - trainer.iteration()) / std::max(rate, 1e-9))
+              .c_str(),
+          l.total, l.surface, l.chart, l.cycle_2d, l.cycle_6d, l.isometry, l.repulsion);
     }
     if (a.checkpoint_every > 0 && trainer.iteration() % a.checkpoint_every == 0) save();
     if (g_signal) {
@@ -291,9 +325,11 @@ void run_fit(FitArgs& a) {
     }
   }
   save();
-  write_run_outputs(trainer.atlas(), shapes, log, dir, MeshOutputOptions{a.mesh_resolution, a.mesh_threshold, a.quiet, a.texture});
+  write_run_outputs(trainer.atlas(), shapes, log, dir,
+                    MeshOutputOptions{a.mesh_resolution, a.mesh_threshold, a.quiet, a.texture});
   if (!a.quiet)
-    std::cerr << "fit: done in " << format_duration(std::chrono::duration<double>(clock::now() - start).count())
+    std::cerr << "fit: done in "
+              << format_duration(std::chrono::duration<double>(clock::now() - start).count())
               << "; results in " << dir << "\n";
 }
 
@@ -313,55 +349,189 @@ const CLI::Validator kFinite(
 void add_fit(CLI::App& app) {
   auto a = std::make_shared<FitArgs>();
   FitOptions& o = a->options;
-  CLI::App* c = app.add_subcommand("fit", "Learn the atlas of a shape: domain P, parametrization phi, chart psi");
-  c->add_option("inputs", a->inputs, "Mesh (.obj .off .ply), oriented point cloud (.ply with normals, .xyz x y z nx ny nz), or builtin:NAME (sphere, torus, cube, capsule); several inputs fit a collection with one shared domain (Sec. 3.4)");
+  // Collections start from one shape's atlas (the template start), 30% of the
+  // run: measured on the SHREC ants and teddies (docs/collections.md).
+  o.template_steps = -1;
+  o.template_share = 0.3;
+  CLI::App* c = app.add_subcommand(
+      "fit", "Learn the atlas of a shape: domain P, parametrization phi, chart psi");
+  c->add_option("inputs", a->inputs,
+                "Mesh (.obj .off .ply), oriented point cloud (.ply with normals, .xyz x y z nx ny "
+                "nz), or builtin:NAME (sphere, torus, cube, capsule); several inputs fit a "
+                "collection with one shared domain (Sec. 3.4)");
   c->add_option("--list", a->list_file, "A file naming one input per line (collections)");
-  c->add_option("--code-size", o.atlas.code_size, "Collections: width of the latent codes f_phi,i and f_psi,i")->capture_default_str()->check(CLI::Range(1, 4096));
-  c->add_option("--w-code", o.weights.code, "Collections: weight of the mean squared norm of the codes")->capture_default_str()->check(CLI::NonNegativeNumber)->check(kFinite);
+  c->add_option("--code-size", o.atlas.code_size,
+                "Collections: width of the latent codes f_phi,i and f_psi,i")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 4096));
+  c->add_option("--w-code", o.weights.code,
+                "Collections: weight of the mean squared norm of the codes")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber)
+      ->check(kFinite);
   c->add_option("-o,--out", a->out_dir, "Output directory (created if needed)");
-  c->add_option("--resume", a->resume, "Continue the run in DIR from its model.ckpt (settings come from the checkpoint)");
-  c->add_option("--iters", o.iterations, "Training iterations")->capture_default_str()->check(CLI::Range(int64_t(0), int64_t(100000000)));
-  c->add_option("--points,-M", o.points, "M: points sampled on P and on the shape per iteration")->capture_default_str()->check(CLI::Range(Index(16), Index(1000000)));
-  c->add_option("--gaussians,-K", o.atlas.gaussians, "K: Gaussians in the domain P (sigma = 1/sqrt(K))")->capture_default_str()->check(CLI::Range(1, 1000000));
-  c->add_option("--width", o.atlas.width, "Hidden units of phi and psi")->capture_default_str()->check(CLI::Range(4, 4096));
-  c->add_option("--depth", o.atlas.hidden_layers, "Hidden layers of phi and psi")->capture_default_str()->check(CLI::Range(1, 32));
-  c->add_option("--alpha", o.atlas.alpha, "Norm of the scaled normals (Eq. 2)")->capture_default_str()->check(CLI::PositiveNumber)->check(kFinite);
-  c->add_option("--lr", o.lr, "Adam learning rate")->capture_default_str()->check(CLI::PositiveNumber)->check(kFinite);
-  c->add_option("--decay", o.decay, "Learning-rate factor at each decay point")->capture_default_str()->check(CLI::Range(0.0, 1.0))->check(kFinite);
-  c->add_option("--decay-at", o.decay_at, "Fractions of --iters where the learning rate decays")->capture_default_str()->check(CLI::Range(0.0, 1.0));
-  c->add_option("--minutes", a->minutes, "Time budget: after 5 warm-up and 20 timed iterations, set --iters to fill it (the schedule follows)")->check(CLI::Range(0.01, 100000.0));
-  c->add_option("--seed", o.seed, "Random seed (same seed and threads -> same run)")->capture_default_str();
-  c->add_option("--threads", a->threads, "Threads (default: all cores; a resumed run keeps its own, as results depend on it)")->check(CLI::Range(0, 1024));
-  c->add_option("--w-6d", o.weights.surface, "lambda_6D on L_6D (Eq. 7)")->capture_default_str()->check(CLI::NonNegativeNumber)->check(kFinite);
-  c->add_option("--w-2d", o.weights.chart, "lambda_2D on L_2D (Eq. 8)")->capture_default_str()->check(CLI::NonNegativeNumber)->check(kFinite);
-  c->add_option("--w-cycle", o.weights.cycle, "lambda_cycle on L_cycle (Eq. 9; mean convention, = paper's 1/M on sums)")->capture_default_str()->check(CLI::NonNegativeNumber)->check(kFinite);
-  c->add_option("--w-iso", o.weights.isometry, "lambda_iso on L_iso (Eq. 10; mean convention, = paper's 1e-4/M on sums)")->capture_default_str()->check(CLI::NonNegativeNumber)->check(kFinite);
-  c->add_option("--w-rep", o.weights.repulsion, "lambda_rep on L_rep (Eq. 11)")->capture_default_str()->check(CLI::NonNegativeNumber)->check(kFinite);
-  c->add_option("--table-row", a->table_row, "Ablation of the paper's Table 1: row 6..11 (11 = full method)")->check(CLI::Range(6, 11));
+  c->add_option("--resume", a->resume,
+                "Continue the run in DIR from its model.ckpt (settings come from the checkpoint)");
+  c->add_option("--iters", o.iterations, "Training iterations")
+      ->capture_default_str()
+      ->check(CLI::Range(int64_t(0), int64_t(100000000)));
+  c->add_option("--points,-M", o.points, "M: points sampled on P and on the shape per iteration")
+      ->capture_default_str()
+      ->check(CLI::Range(Index(16), Index(1000000)));
+  c->add_option("--gaussians,-K", o.atlas.gaussians,
+                "K: Gaussians in the domain P (sigma = 1/sqrt(K))")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000000));
+  c->add_option("--width", o.atlas.width, "Hidden units of phi and psi")
+      ->capture_default_str()
+      ->check(CLI::Range(4, 4096));
+  c->add_option("--depth", o.atlas.hidden_layers, "Hidden layers of phi and psi")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 32));
+  c->add_option("--alpha", o.atlas.alpha, "Norm of the scaled normals (Eq. 2)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber)
+      ->check(kFinite);
+  c->add_option("--lr", o.lr, "Adam learning rate")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber)
+      ->check(kFinite);
+  c->add_option("--decay", o.decay, "Learning-rate factor at each decay point")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0))
+      ->check(kFinite);
+  c->add_option("--decay-at", o.decay_at, "Fractions of --iters where the learning rate decays")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  c->add_option("--minutes", a->minutes,
+                "Time budget: after 5 warm-up and 20 timed iterations, set --iters to fill it (the "
+                "schedule follows)")
+      ->check(CLI::Range(0.01, 100000.0));
+  c->add_option("--seed", o.seed, "Random seed (same seed and threads -> same run)")
+      ->capture_default_str();
+  c->add_option(
+       "--threads", a->threads,
+       "Threads (default: all cores; a resumed run keeps its own, as results depend on it)")
+      ->check(CLI::Range(0, 1024));
+  c->add_option("--w-6d", o.weights.surface, "lambda_6D on L_6D (Eq. 7)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber)
+      ->check(kFinite);
+  c->add_option("--w-2d", o.weights.chart, "lambda_2D on L_2D (Eq. 8)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber)
+      ->check(kFinite);
+  c->add_option("--w-cycle", o.weights.cycle,
+                "lambda_cycle on L_cycle (Eq. 9; mean convention, = paper's 1/M on sums)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber)
+      ->check(kFinite);
+  c->add_option("--w-iso", o.weights.isometry,
+                "lambda_iso on L_iso (Eq. 10; mean convention, = paper's 1e-4/M on sums)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber)
+      ->check(kFinite);
+  c->add_option("--w-rep", o.weights.repulsion, "lambda_rep on L_rep (Eq. 11)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber)
+      ->check(kFinite);
+  c->add_option("--table-row", a->table_row,
+                "Ablation of the paper's Table 1: row 6..11 (11 = full method)")
+      ->check(CLI::Range(6, 11));
   c->add_flag("--no-normals", a->no_normals, "Ablation: 3D Chamfer without normals");
   c->add_flag("--no-repulsion", a->no_repulsion, "Ablation: no L_rep");
-  c->add_flag("--no-distribution", a->no_distribution, "Ablation: sample the Gaussian means only (a learned point set)");
+  c->add_flag("--no-distribution", a->no_distribution,
+              "Ablation: sample the Gaussian means only (a learned point set)");
   c->add_flag("--no-chart", a->no_chart, "Ablation: no chart psi, no L_2D, no L_cycle");
   c->add_flag("--no-isometry", a->no_isometry, "Ablation: no L_iso");
-  c->add_option("--preset", a->preset, "paper: M = K = 10^4, 5 x 256 ReLU MLPs, alpha 0.01, lambda_cycle 1, no wrap, reseed or dense surface (slow on a laptop; these win over the same settings' flags)");
-  c->add_option("--pool", o.pool, "Surface samples drawn once from the input")->capture_default_str()->check(CLI::Range(Index(100), Index(10000000)));
-  c->add_option("--repulsion-tolerance", o.repulsion_tolerance, "Bound on the error of L_rep from its cut-off radius")->capture_default_str()->check(CLI::Range(1e-15, 1e-2))->check(kFinite);
-  c->add_option("--softplus", o.atlas.softplus_beta, "Activation of phi and psi: BETA > 0 softplus log(1 + e^(BETA z)) / BETA (smooth normals), 0 ReLU (the paper)")->capture_default_str()->check(CLI::Range(0.0, 1e6))->check(kFinite);
-  c->add_option("--code-layer", o.atlas.code_layer, "Collections: where the codes enter phi and psi: 0 the input (concatenation), 1 after the first layer")->capture_default_str()->check(CLI::Range(0, 1));
-  c->add_option("--reseed", o.reseed_every, "Every N steps before the first decay, move the Gaussians of back-facing flaps to the surface's holes (0: never, as the paper; see model/reseed.h)")->capture_default_str()->check(CLI::Range(0, 1000000));
-  c->add_flag("--dense-surface,!--no-dense-surface", o.dense_surface, "L_6D matches phi6(x_P) in the whole pool of surface samples, not only the step's M (sharper pull; see losses/chamfer.h)")->capture_default_str();
-  c->add_option("--wrap", o.wrap_steps, "Steps fitting phi and psi to a closed ellipsoid around the shape before training (0: random start, as the paper; see model/wrap.h)")->capture_default_str()->check(CLI::Range(0, 1000000));
-  c->add_option("--code-lr-scale", o.code_lr_scale, "Collections: learning rate of the latent codes as a multiple of the networks'")->capture_default_str()->check(CLI::Range(1e-3, 1e3))->check(kFinite);
-  c->add_option("--chart-from", o.chart_from, "Staged objective: phi and P alone (no psi, L_2D, L_cycle) until this fraction of --iters, then the full method (0: full from the start)")->capture_default_str()->check(CLI::Range(0.0, 1.0))->check(kFinite);
-  c->add_option("--template-steps", o.template_steps, "Collections: steps fitting shape 0 alone before the joint training, then its codes copied to every shape (-1: from --template-share)")->capture_default_str()->check(CLI::Range(int64_t(-1), int64_t(100000000)));
-  c->add_option("--template-share", o.template_share, "Collections, with --template-steps -1: share of the run's time (or cost) spent on the template start")->capture_default_str()->check(CLI::Range(0.0, 0.95))->check(kFinite);
-  c->add_flag("--align,!--no-align", o.align_poses, "Collections: turn every shape into the pose of the first (principal axes, ICP, lowest Chamfer) before fitting; rotations.json lists them")->capture_default_str();
-  c->add_option("--batch-shapes", o.batch_shapes, "Collections: shapes per iteration, a seeded random subset (0: all); the loss is scaled by N/B")->capture_default_str()->check(CLI::NonNegativeNumber);
-  c->add_option("--orient-every", o.orient_every, "Choose phi's global orientation every N iterations until the first decay (0: never; see model/orientation.h)")->capture_default_str()->check(CLI::NonNegativeNumber);
-  c->add_option("--checkpoint-every", a->checkpoint_every, "Write model.ckpt every N iterations (0: only at the end)")->capture_default_str()->check(CLI::NonNegativeNumber);
-  c->add_option("--mesh-resolution", a->mesh_resolution, "Grid cells across the domain for domain_mesh.obj")->capture_default_str()->check(CLI::Range(8, 4096));
-  c->add_option("--mesh-threshold", a->mesh_threshold, "Domain = {P >= t * median of P at the means}")->capture_default_str()->check(CLI::Range(0.0, 100.0))->check(kFinite);
-  c->add_option("--texture", a->texture, "An image for the MTLs of the results; also writes texture_transfer.png");
+  c->add_option(
+      "--preset", a->preset,
+      "paper: M = K = 10^4, 5 x 256 ReLU MLPs, alpha 0.01, lambda_cycle 1, no wrap, reseed or "
+      "dense surface (slow on a laptop; these win over the same settings' flags)");
+  c->add_option("--pool", o.pool, "Surface samples drawn once from the input")
+      ->capture_default_str()
+      ->check(CLI::Range(Index(100), Index(10000000)));
+  c->add_option("--repulsion-tolerance", o.repulsion_tolerance,
+                "Bound on the error of L_rep from its cut-off radius")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-15, 1e-2))
+      ->check(kFinite);
+  c->add_option("--softplus", o.atlas.softplus_beta,
+                "Activation of phi and psi: BETA > 0 softplus log(1 + e^(BETA z)) / BETA (smooth "
+                "normals), 0 ReLU (the paper)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e6))
+      ->check(kFinite);
+  c->add_option("--code-layer", o.atlas.code_layer,
+                "Collections: where the codes enter phi and psi: 0 the input (concatenation), 1 "
+                "after the first layer")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1));
+  c->add_option("--reseed", o.reseed_every,
+                "Every N steps before the first decay, move the Gaussians of back-facing flaps to "
+                "the surface's holes (0: never, as the paper; see model/reseed.h)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000000));
+  c->add_flag("--dense-surface,!--no-dense-surface", o.dense_surface,
+              "L_6D matches phi6(x_P) in the whole pool of surface samples, not only the step's M "
+              "(sharper pull; see losses/chamfer.h)")
+      ->capture_default_str();
+  c->add_option("--wrap", o.wrap_steps,
+                "Steps fitting phi and psi to a closed ellipsoid around the shape before training "
+                "(0: random start, as the paper; see model/wrap.h)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000000));
+  c->add_option("--code-lr-scale", o.code_lr_scale,
+                "Collections: learning rate of the latent codes as a multiple of the networks'")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-3, 1e3))
+      ->check(kFinite);
+  c->add_option("--chart-from", o.chart_from,
+                "Staged objective: phi and P alone (no psi, L_2D, L_cycle) until this fraction of "
+                "--iters, then the full method (0: full from the start)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0))
+      ->check(kFinite);
+  c->add_option("--template-steps", o.template_steps,
+                "Collections: steps fitting shape 0 alone before the joint training, then its "
+                "codes copied to every shape (-1: from --template-share)")
+      ->capture_default_str()
+      ->check(CLI::Range(int64_t(-1), int64_t(100000000)));
+  c->add_option("--template-share", o.template_share,
+                "Collections, with --template-steps -1: share of the run's time (or cost) spent on "
+                "the template start")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.95))
+      ->check(kFinite);
+  c->add_flag("--align,!--no-align", o.align_poses,
+              "Collections: turn every shape into the pose of the first (principal axes, ICP, "
+              "lowest Chamfer) before fitting; rotations.json lists them")
+      ->capture_default_str();
+  c->add_option("--batch-shapes", o.batch_shapes,
+                "Collections: shapes per iteration, a seeded random subset (0: all); the loss is "
+                "scaled by N/B")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  c->add_option("--orient-every", o.orient_every,
+                "Choose phi's global orientation every N iterations until the first decay (0: "
+                "never; see model/orientation.h)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  c->add_option("--checkpoint-every", a->checkpoint_every,
+                "Write model.ckpt every N iterations (0: only at the end)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  c->add_option("--mesh-resolution", a->mesh_resolution,
+                "Grid cells across the domain for domain_mesh.obj")
+      ->capture_default_str()
+      ->check(CLI::Range(8, 4096));
+  c->add_option("--mesh-threshold", a->mesh_threshold,
+                "Domain = {P >= t * median of P at the means}")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100.0))
+      ->check(kFinite);
+  c->add_option("--texture", a->texture,
+                "An image for the MTLs of the results; also writes texture_transfer.png");
   c->add_flag("-q,--quiet", a->quiet, "No progress output");
   c->callback([a]() { run_fit(*a); });
 }

@@ -2,16 +2,15 @@
 
 #include <filesystem>
 #include <iostream>
-
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_write.h"
 #include "io/mesh_io.h"
+#include "io/raster.h"
 #include "losses/uv_quality.h"
 #include "model/chart_mesh.h"
 #include "model/domain_mesh.h"
 #include "model/pictures.h"
-#include "io/raster.h"
 
 namespace jsa::cli {
 namespace {
@@ -55,7 +54,8 @@ void write_domain_mesh(Atlas<float>& atlas, const Normalization& normalization,
                        const std::string& obj_path, const MeshOutputOptions& o, int shape) {
   const DomainMesh dm = mesh_domain(atlas, DomainMeshOptions{o.resolution, o.threshold});
   if (dm.faces.rows() == 0)
-    throw InputError("mesh: no domain above the threshold " + std::to_string(o.threshold) + " (lower --threshold)");
+    throw InputError("mesh: no domain above the threshold " + std::to_string(o.threshold) +
+                     " (lower --threshold)");
   Mesh out;
   Block<double> points, normals;
   evaluate_surface(atlas, dm.uv, points, normals, shape);
@@ -66,19 +66,24 @@ void write_domain_mesh(Atlas<float>& atlas, const Normalization& normalization,
   write_obj(obj_path, out, &vt, write_material(obj_path, o.texture), "atlas");
   const std::string stem = stem_of(obj_path);
   const UvQuality q = measure_uv_quality(out.vertices, out.faces, vt, out.faces);
-  write_report(stem + "_uv.json", q, {{"domain_mass_fraction", dm.mass_fraction}, {"threshold", o.threshold},
-                                      {"level", dm.level}, {"map", "domain uv -> phi (3D)"}});
+  write_report(stem + "_uv.json", q,
+               {{"domain_mass_fraction", dm.mass_fraction},
+                {"threshold", o.threshold},
+                {"level", dm.level},
+                {"map", "domain uv -> phi (3D)"}});
   write_png(stem + ".png", domain_coloured_views(out.vertices, out.faces, vt));
   if (!o.quiet) {
-    std::cerr << "mesh: " << obj_path << "  (" << out.vertices.rows() << " vertices, " << out.faces.rows()
-              << " triangles; the domain holds " << int(100 * dm.mass_fraction + 0.5) << "% of P's mass)\n";
+    std::cerr << "mesh: " << obj_path << "  (" << out.vertices.rows() << " vertices, "
+              << out.faces.rows() << " triangles; the domain holds "
+              << int(100 * dm.mass_fraction + 0.5) << "% of P's mass)\n";
     std::cerr << to_text(q);
   }
 }
 
 void write_chart(Atlas<float>& atlas, const Normalization& normalization, const Mesh& mesh,
                  const std::string& obj_path, const ChartOutputOptions& o, int shape) {
-  if (mesh.faces.rows() == 0) throw InputError("chart: the input has no faces (a point cloud has no UV map to write)");
+  if (mesh.faces.rows() == 0)
+    throw InputError("chart: the input has no faces (a point cloud has no UV map to write)");
   const Block<double> uv = chart_vertices(atlas, mesh, normalization, shape);
   const TextureFrame frame = texture_frame(atlas);
   Block<double> vt = frame.to_texture(uv);
@@ -93,18 +98,21 @@ void write_chart(Atlas<float>& atlas, const Normalization& normalization, const 
     uv_faces = split.uv_faces;
     q = measure_uv_quality(mesh.vertices, mesh.faces, vt, uv_faces, qo);
   }
-  write_obj(obj_path, mesh, &vt, write_material(obj_path, o.texture), "atlas", o.split_cuts ? &uv_faces : nullptr);
+  write_obj(obj_path, mesh, &vt, write_material(obj_path, o.texture), "atlas",
+            o.split_cuts ? &uv_faces : nullptr);
   const std::string stem = stem_of(obj_path);
-  write_report(stem + "_uv.json", q, {{"map", "input mesh -> psi (2D); measured as uv -> 3D"},
-                                      {"split_cuts", o.split_cuts}, {"torn_before_split", torn_before}});
+  write_report(stem + "_uv.json", q,
+               {{"map", "input mesh -> psi (2D); measured as uv -> 3D"},
+                {"split_cuts", o.split_cuts},
+                {"torn_before_split", torn_before}});
   const Block<double> vertex_vt = frame.to_texture(uv);
   write_png(stem + ".png", domain_coloured_views(mesh.vertices, mesh.faces, vertex_vt));
-  write_png(stem + "_layout.png",
-            uv_layout_picture(mesh.vertices, mesh.faces, vt, uv_faces, q.flipped_faces, q.torn_faces));
+  write_png(stem + "_layout.png", uv_layout_picture(mesh.vertices, mesh.faces, vt, uv_faces,
+                                                    q.flipped_faces, q.torn_faces));
   if (!o.quiet) {
-    std::cerr << "chart: " << obj_path << "  (" << mesh.vertices.rows() << " vertices, " << mesh.faces.rows()
-              << " faces in the input's order; " << torn_before << " torn across the cut"
-              << (o.split_cuts ? ", split" : "") << ")\n";
+    std::cerr << "chart: " << obj_path << "  (" << mesh.vertices.rows() << " vertices, "
+              << mesh.faces.rows() << " faces in the input's order; " << torn_before
+              << " torn across the cut" << (o.split_cuts ? ", split" : "") << ")\n";
     std::cerr << to_text(q);
   }
 }
@@ -127,14 +135,16 @@ void write_run_outputs(Atlas<float>& atlas, const std::vector<RunInput>& inputs,
       ChartOutputOptions co;
       co.quiet = mesh.quiet;
       co.texture = mesh.texture;
-      write_chart(atlas, inputs[i].normalization, inputs[i].mesh, sub + "/input_chart.obj", co, int(i));
+      write_chart(atlas, inputs[i].normalization, inputs[i].mesh, sub + "/input_chart.obj", co,
+                  int(i));
       // One view per shape, coloured by its position in the shared domain
       // (and, with a texture, textured through its chart).
       const Mesh& m = inputs[i].mesh;
-      const Block<double> vt =
-          texture_frame(atlas).to_texture(chart_vertices(atlas, m, inputs[i].normalization, int(i)));
+      const Block<double> vt = texture_frame(atlas).to_texture(
+          chart_vertices(atlas, m, inputs[i].normalization, int(i)));
       if (collection) coloured.push_back(domain_coloured_views(m.vertices, m.faces, vt, 320));
-      if (texture.width > 0) textured.push_back(textured_views(m.vertices, m.faces, vt, texture, 320));
+      if (texture.width > 0)
+        textured.push_back(textured_views(m.vertices, m.faces, vt, texture, 320));
       captions.push_back("shape " + std::to_string(i));
     }
   }

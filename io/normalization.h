@@ -14,7 +14,8 @@ namespace jsa {
 struct Normalization {
   Eigen::RowVector3d center = Eigen::RowVector3d::Zero();  // mean of the points
   double scale = 1;                                        // max distance from center; > 0
-  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // rows turn as x -> x * rotation; det = +1
+  Eigen::Matrix3d rotation =
+      Eigen::Matrix3d::Identity();  // rows turn as x -> x * rotation; det = +1
 
   Block<double> to_unit(const Block<double>& points) const;    // (p - center) / scale * rotation
   Block<double> from_unit(const Block<double>& points) const;  // p * rotation^T * scale + center

@@ -37,7 +37,8 @@ void put_string(std::string& out, const std::string& s) {
 void write_checkpoint(const std::string& path, const std::vector<std::string>& inputs,
                       const FitOptions& options, const std::vector<Normalization>& normalizations,
                       const Trainer& trainer) {
-  JSA_CHECK(inputs.size() == normalizations.size() && !inputs.empty(), "one normalisation per input");
+  JSA_CHECK(inputs.size() == normalizations.size() && !inputs.empty(),
+            "one normalisation per input");
   std::string body(kMagic, sizeof kMagic);
   body.append(reinterpret_cast<const char*>(&kVersion), sizeof kVersion);
   const uint64_t count = inputs.size();
@@ -55,7 +56,8 @@ void write_checkpoint(const std::string& path, const std::vector<std::string>& i
   put_string(body, state.str());
   const uint64_t sum = fnv1a(body.data(), body.size());
   body.append(reinterpret_cast<const char*>(&sum), sizeof sum);
-  write_file_atomically(path, [&](std::ostream& out) { out.write(body.data(), std::streamsize(body.size())); });
+  write_file_atomically(
+      path, [&](std::ostream& out) { out.write(body.data(), std::streamsize(body.size())); });
 }
 
 CheckpointContents read_checkpoint(const std::string& path) {
@@ -87,12 +89,13 @@ CheckpointContents read_checkpoint(const std::string& path) {
   uint32_t version = 0;
   take(&version, sizeof version);
   if (version != kVersion && version != 1)
-    throw InputError(path + ": checkpoint format " + std::to_string(version) + ", this build reads 1 to " +
-                     std::to_string(kVersion));
+    throw InputError(path + ": checkpoint format " + std::to_string(version) +
+                     ", this build reads 1 to " + std::to_string(kVersion));
   CheckpointContents c;
   uint64_t count = 0;
   take(&count, sizeof count);
-  if (count == 0 || count > 100000) throw InputError(path + ": implausible shape count in checkpoint");
+  if (count == 0 || count > 100000)
+    throw InputError(path + ": implausible shape count in checkpoint");
   for (uint64_t i = 0; i < count; ++i) c.inputs.push_back(take_string());
   c.settings_json = take_string();
   for (uint64_t i = 0; i < count; ++i) {
@@ -101,12 +104,15 @@ CheckpointContents read_checkpoint(const std::string& path) {
     Normalization n;
     n.center = Eigen::RowVector3d(norm[0], norm[1], norm[2]);
     n.scale = norm[3];
-    if (!(n.scale > 0) || !n.center.allFinite()) throw InputError(path + ": bad normalisation in checkpoint");
+    if (!(n.scale > 0) || !n.center.allFinite())
+      throw InputError(path + ": bad normalisation in checkpoint");
     if (version >= 2) {
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c) n.rotation(r, c) = norm[4 + 3 * r + c];
       const bool rotation = n.rotation.allFinite() &&
-                            (n.rotation * n.rotation.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-6 &&
+                            (n.rotation * n.rotation.transpose() - Eigen::Matrix3d::Identity())
+                                    .cwiseAbs()
+                                    .maxCoeff() < 1e-6 &&
                             n.rotation.determinant() > 0;
       if (!rotation) throw InputError(path + ": bad rotation in checkpoint");
     }
@@ -117,12 +123,14 @@ CheckpointContents read_checkpoint(const std::string& path) {
   return c;
 }
 
-void restore_trainer(Trainer& trainer, const CheckpointContents& contents, const std::string& path) {
+void restore_trainer(Trainer& trainer, const CheckpointContents& contents,
+                     const std::string& path) {
   std::istringstream state(contents.state);
   trainer.load_state(state, path);
 }
 
-std::unique_ptr<Atlas<float>> load_atlas(const CheckpointContents& contents, const std::string& path) {
+std::unique_ptr<Atlas<float>> load_atlas(const CheckpointContents& contents,
+                                         const std::string& path) {
   const FitOptions o = fit_options_from_json(contents.settings_json, path);
   AtlasOptions ao = o.atlas;
   ao.gaussian_noise = o.components.distribution;

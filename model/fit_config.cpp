@@ -3,9 +3,8 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <type_traits>
-
 #include <nlohmann/json.hpp>
+#include <type_traits>
 
 namespace jsa {
 
@@ -113,7 +112,8 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   field(a, "atlas.", "alpha", o.atlas.alpha);
   field(a, "atlas.", "shapes", o.atlas.shapes);
   field(a, "atlas.", "code_size", o.atlas.code_size);
-  if (a.contains("code_layer")) field(a, "atlas.", "code_layer", o.atlas.code_layer);  // later addition: absent = 0
+  if (a.contains("code_layer"))
+    field(a, "atlas.", "code_layer", o.atlas.code_layer);  // later addition: absent = 0
   o.atlas.softplus_beta = 0;  // later addition: absent = ReLU, what older runs used
   if (a.contains("softplus_beta")) field(a, "atlas.", "softplus_beta", o.atlas.softplus_beta);
   const json& w = j.contains("weights") ? j["weights"] : json();
@@ -156,24 +156,28 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (j.contains("template_share")) field(j, "", "template_share", o.template_share);
   o.code_lr_scale = 1;
   if (j.contains("code_lr_scale")) field(j, "", "code_lr_scale", o.code_lr_scale);
-  if (!(o.code_lr_scale > 0) || !std::isfinite(o.code_lr_scale)) throw InputError(what + ": code_lr_scale must be positive");
+  if (!(o.code_lr_scale > 0) || !std::isfinite(o.code_lr_scale))
+    throw InputError(what + ": code_lr_scale must be positive");
   o.chart_from = 0;
   if (j.contains("chart_from")) field(j, "", "chart_from", o.chart_from);
-  if (!(o.chart_from >= 0 && o.chart_from <= 1)) throw InputError(what + ": chart_from must be in [0, 1]");
+  if (!(o.chart_from >= 0 && o.chart_from <= 1))
+    throw InputError(what + ": chart_from must be in [0, 1]");
   if (o.template_steps < -1 || !(o.template_share >= 0 && o.template_share < 1))
     throw InputError(what + ": template_steps must be >= -1 and template_share in [0, 1)");
   field(j, "", "pool", o.pool);
   field(j, "", "threads", o.threads);
   if (o.atlas.gaussians <= 0 || o.atlas.width <= 0 || o.atlas.hidden_layers < 0 || o.points <= 0 ||
-      o.atlas.shapes <= 0 || o.atlas.code_size <= 0 || o.pool <= 0 || o.threads < 0 || o.orient_every < 0 || o.batch_shapes < 0 || o.wrap_steps < 0 || o.reseed_every < 0 || o.atlas.code_layer < 0 || o.atlas.code_layer > 1 || !(o.lr > 0) ||
+      o.atlas.shapes <= 0 || o.atlas.code_size <= 0 || o.pool <= 0 || o.threads < 0 ||
+      o.orient_every < 0 || o.batch_shapes < 0 || o.wrap_steps < 0 || o.reseed_every < 0 ||
+      o.atlas.code_layer < 0 || o.atlas.code_layer > 1 || !(o.lr > 0) ||
       !(o.atlas.softplus_beta >= 0) || !std::isfinite(o.atlas.softplus_beta) ||
       !std::isfinite(o.lr))
     throw InputError(what + ": sizes must be positive");
   // The same bounds as the command line's, so a crafted file cannot make the
   // atlas allocate without limit.
   if (o.atlas.gaussians > 1000000 || o.atlas.width > 4096 || o.atlas.hidden_layers > 32 ||
-      o.atlas.code_size > 4096 || o.atlas.shapes > 100000 || o.points > 1000000 || o.pool > 10000000 ||
-      o.threads > 1024 || o.wrap_steps > 1000000)
+      o.atlas.code_size > 4096 || o.atlas.shapes > 100000 || o.points > 1000000 ||
+      o.pool > 10000000 || o.threads > 1024 || o.wrap_steps > 1000000)
     throw InputError(what + ": a size is beyond the command line's limits (corrupt settings?)");
   return o;
 }

@@ -32,7 +32,8 @@ void set_rotation(RunInput& input, const Eigen::Matrix3d& rotation) {
   input.normalization.rotation = rotation;
 }
 
-std::vector<RigidAlignment> align_to_first(std::vector<RunInput>& inputs, const RigidAlignOptions& options) {
+std::vector<RigidAlignment> align_to_first(std::vector<RunInput>& inputs,
+                                           const RigidAlignOptions& options) {
   std::vector<RigidAlignment> out(inputs.size());
   if (inputs.empty()) return out;
   for (size_t i = 1; i < inputs.size(); ++i) {

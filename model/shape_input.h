@@ -28,6 +28,7 @@ void set_rotation(RunInput& input, const Eigen::Matrix3d& rotation);
 // The pose step of a collection: every shape after the first is rotated onto
 // the first (rigid_align on the pools in the unit frames; docs/collections.md).
 // Returns one alignment per shape (the first: the identity).
-std::vector<RigidAlignment> align_to_first(std::vector<RunInput>& inputs, const RigidAlignOptions& options = {});
+std::vector<RigidAlignment> align_to_first(std::vector<RunInput>& inputs,
+                                           const RigidAlignOptions& options = {});
 
 }  // namespace jsa

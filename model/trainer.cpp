@@ -22,7 +22,8 @@ Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools)
     pools_.push_back(pool.cast<float>());
     pools_.back().rightCols(3) *= float(o.atlas.alpha);
     if (o.dense_surface)
-      surfaces_.emplace_back(o.components.normals ? pools_.back() : Block<float>(pools_.back().leftCols(3)));
+      surfaces_.emplace_back(o.components.normals ? pools_.back()
+                                                  : Block<float>(pools_.back().leftCols(3)));
   }
   const int n = int(pools.size());
   const int b = o.batch_shapes > 0 && o.batch_shapes < n ? o.batch_shapes : n;
@@ -39,7 +40,8 @@ Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools)
 
 double Trainer::learning_rate() const {
   std::vector<int64_t> milestones;
-  for (double f : options_.decay_at) milestones.push_back(int64_t(std::llround(f * double(options_.iterations))));
+  for (double f : options_.decay_at)
+    milestones.push_back(int64_t(std::llround(f * double(options_.iterations))));
   return lr_scale_ * step_decay(options_.lr, iteration_, milestones, options_.decay);
 }
 
@@ -54,15 +56,17 @@ WrapReport Trainer::wrap(const std::function<bool()>& cancelled) {
   if (wrapped_ || iteration_ > 0 || options_.wrap_steps <= 0) return {};
   wrapped_ = true;
   Rng rng(options_.seed, 2);  // its own stream: the training draws are the same with or without it
-  return wrap_initialize(*atlas_, pools_, options_.wrap_steps, options_.points, options_.lr, rng, cancelled);
+  return wrap_initialize(*atlas_, pools_, options_.wrap_steps, options_.points, options_.lr, rng,
+                         cancelled);
 }
 
 void Trainer::step() {
   if (iteration_ == 0 && !wrapped_) wrap();
   const int n = int(pools_.size()), b = int(batch_.size());
   if (iteration_ == 0 && n > 1 && !template_finished_) {
-    const int64_t want = options_.template_steps >= 0 ? options_.template_steps
-                                                      : template_steps_for(options_, options_.iterations, n);
+    const int64_t want = options_.template_steps >= 0
+                             ? options_.template_steps
+                             : template_steps_for(options_, options_.iterations, n);
     if (want > 0) {
       if (template_done_ < want) train_template(want - template_done_);
       finish_template();
@@ -72,7 +76,8 @@ void Trainer::step() {
     // A uniform subset of B shapes: the first B of a partial Fisher-Yates shuffle.
     std::vector<int> order(static_cast<size_t>(n));
     for (int i = 0; i < n; ++i) order[size_t(i)] = i;
-    for (int i = 0; i < b; ++i) std::swap(order[size_t(i)], order[size_t(i) + rng_.below(uint64_t(n - i))]);
+    for (int i = 0; i < b; ++i)
+      std::swap(order[size_t(i)], order[size_t(i) + rng_.below(uint64_t(n - i))]);
     batch_.assign(order.begin(), order.begin() + b);
   }
   if (!train_on(batch_, learning_rate(), iteration_)) return;
@@ -86,11 +91,13 @@ int64_t Trainer::template_steps_for(const FitOptions& o, int64_t iterations, int
   if (o.template_steps >= 0) return o.template_steps;
   if (shapes <= 1 || !(o.template_share > 0) || o.template_share >= 1) return 0;
   // A template step costs about 1/N of a joint step (one shape instead of N).
-  return int64_t(std::llround(o.template_share / (1 - o.template_share) * double(iterations) * shapes));
+  return int64_t(
+      std::llround(o.template_share / (1 - o.template_share) * double(iterations) * shapes));
 }
 
 void Trainer::train_template(int64_t steps, const std::function<bool()>& cancelled) {
-  JSA_CHECK(iteration_ == 0 && !template_finished_, "the template start runs before the joint training");
+  JSA_CHECK(iteration_ == 0 && !template_finished_,
+            "the template start runs before the joint training");
   if (pools_.size() < 2) return;
   const std::vector<int> template_batch{0};
   for (int64_t k = 0; k < steps; ++k) {
@@ -112,7 +119,8 @@ void Trainer::finish_template() {
     const int id = atlas_->params.find(name);
     JSA_CHECK(id >= 0, "the atlas has no " << name);
     const auto& e = atlas_->params.entry(id);
-    for (std::vector<float>* buffer : {&atlas_->params.values(), &adam_.first_moment(), &adam_.second_moment()}) {
+    for (std::vector<float>* buffer :
+         {&atlas_->params.values(), &adam_.first_moment(), &adam_.second_moment()}) {
       if (buffer->empty()) continue;
       float* block = buffer->data() + e.offset;  // rows x cols, row-major: one code per row
       for (Index r = 1; r < e.rows; ++r)
@@ -128,13 +136,15 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, int64_t counter
   // M targets {x_S, n_S} per shape of the batch, drawn with replacement from its pool.
   for (int k = 0; k < b; ++k) {
     const Block<float>& pool = pools_[size_t(batch[size_t(k)])];
-    for (Index m = 0; m < options_.points; ++m) targets_[size_t(k)].row(m) = pool.row(Index(rng_.below(uint64_t(pool.rows()))));
+    for (Index m = 0; m < options_.points; ++m)
+      targets_[size_t(k)].row(m) = pool.row(Index(rng_.below(uint64_t(pool.rows()))));
   }
   tape_.clear();
   ObjectiveOptions objective{options_.weights, options_.components, options_.repulsion_tolerance};
-  if (double(iteration_) < options_.chart_from * double(options_.iterations)) objective.components.chart = false;
-  Var loss = collection_objective(tape_, *atlas_, targets_, options_.points, rng_, objective, &last_,
-                                  b < n ? batch : std::vector<int>{}, surfaces_);
+  if (double(iteration_) < options_.chart_from * double(options_.iterations))
+    objective.components.chart = false;
+  Var loss = collection_objective(tape_, *atlas_, targets_, options_.points, rng_, objective,
+                                  &last_, b < n ? batch : std::vector<int>{}, surfaces_);
   atlas_->params.zero_grad();
   tape_.backward(loss);
   if (counter == fault_at_ && faults_to_inject_ > 0) {
@@ -153,8 +163,7 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, int64_t counter
       adam_.set_steps(good_steps_);
     }
     lr_scale_ *= 0.5;
-    if (++faults_in_a_row_ > options_.max_faults)
-      throw NumericalFault(faults_in_a_row_, counter);
+    if (++faults_in_a_row_ > options_.max_faults) throw NumericalFault(faults_in_a_row_, counter);
     return false;
   }
   faults_in_a_row_ = 0;
@@ -187,7 +196,8 @@ void Trainer::choose_orientation(int64_t counter, bool in_window) {
   Rng rng(options_.seed, 1000 + uint64_t(counter / every));
   double back = 0;
   for (size_t i = 0; i < targets_.size(); ++i)
-    back += back_facing_fraction(*atlas_, targets_[i], std::min<Index>(options_.points, 2000), rng, batch_step_[i]);
+    back += back_facing_fraction(*atlas_, targets_[i], std::min<Index>(options_.points, 2000), rng,
+                                 batch_step_[i]);
   if (back / double(targets_.size()) <= 0.5) return;
   mirror_domain(*atlas_, {&adam_.first_moment(), &adam_.second_moment()});
   ++mirrors_;
@@ -211,8 +221,8 @@ void Trainer::reseed() {
     for (Index m = 0; m < count; ++m) t.row(m) = pool.row(Index(rng.below(uint64_t(pool.rows()))));
     targets.push_back(std::move(t));
   }
-  const ReseedReport r =
-      reseed_flipped_means(*atlas_, targets, batch_step_, rng, {&adam_.first_moment(), &adam_.second_moment()});
+  const ReseedReport r = reseed_flipped_means(*atlas_, targets, batch_step_, rng,
+                                              {&adam_.first_moment(), &adam_.second_moment()});
   if (r.flipped == 0) return;
   reseeded_ += r.flipped;
   take_snapshot();
@@ -221,7 +231,9 @@ void Trainer::reseed() {
 // Layout: i64 iteration, 4 x u64 RNG state, i64 Adam steps, f64 lr scale, parameters,
 // then Adam's two moment vectors (u64 length + floats each).
 void Trainer::save_state(std::ostream& out) const {
-  auto put = [&](const void* p, size_t n) { out.write(static_cast<const char*>(p), std::streamsize(n)); };
+  auto put = [&](const void* p, size_t n) {
+    out.write(static_cast<const char*>(p), std::streamsize(n));
+  };
   put(&iteration_, sizeof iteration_);
   const auto s = rng_.state();
   put(s.data(), sizeof(uint64_t) * 4);
@@ -253,7 +265,8 @@ void Trainer::load_state(std::istream& in, const std::string& what) {
   for (std::vector<float>* v : {&adam_.first_moment(), &adam_.second_moment()}) {
     uint64_t n = 0;
     get(&n, sizeof n);
-    if (n != 0 && n != atlas_->params.size()) throw InputError(what + ": Adam state does not match the model");
+    if (n != 0 && n != atlas_->params.size())
+      throw InputError(what + ": Adam state does not match the model");
     v->resize(n);
     get(v->data(), sizeof(float) * n);
   }

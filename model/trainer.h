@@ -38,19 +38,19 @@ struct FitOptions {
     // input out with fewer flipped triangles (docs/method.md, "lambda_cycle").
     weights.cycle = 0.1;
   }
-  AtlasOptions atlas;          // K, network sizes, alpha
-  LossWeights weights;         // the lambdas of Eq. 5 (mean convention)
-  Components components;       // ablation switches (default: full method, row 11)
-  int64_t iterations = 5000;   // Adam steps
-  Index points = 2500;         // M: points sampled on P and on the shape per step
-  double lr = 1e-3;            // Adam learning rate
+  AtlasOptions atlas;                          // K, network sizes, alpha
+  LossWeights weights;                         // the lambdas of Eq. 5 (mean convention)
+  Components components;                       // ablation switches (default: full method, row 11)
+  int64_t iterations = 5000;                   // Adam steps
+  Index points = 2500;                         // M: points sampled on P and on the shape per step
+  double lr = 1e-3;                            // Adam learning rate
   std::vector<double> decay_at = {0.75, 0.9};  // fractions of `iterations` where lr *= decay
-  double decay = 0.1;          // step-decay factor
-  uint64_t seed = 1;           // every random draw derives from it
-  double repulsion_tolerance = 1e-7;  // cut-off error bound of L_rep
-  int max_faults = 5;          // NaN/Inf recoveries in a row before giving up
-  Index pool = 200000;         // surface samples drawn once per shape (the targets' pool)
-  int threads = 0;             // threads of the run (0: all); results depend on seed and threads
+  double decay = 0.1;                          // step-decay factor
+  uint64_t seed = 1;                           // every random draw derives from it
+  double repulsion_tolerance = 1e-7;           // cut-off error bound of L_rep
+  int max_faults = 5;                          // NaN/Inf recoveries in a row before giving up
+  Index pool = 200000;  // surface samples drawn once per shape (the targets' pool)
+  int threads = 0;      // threads of the run (0: all); results depend on seed and threads
   // Every this many iterations before the first decay point, choose the global
   // orientation of phi (model/orientation.h); 0: never. Only with normals in the loss.
   int orient_every = 100;
@@ -84,7 +84,9 @@ struct FitOptions {
   // Collections: the latent codes' learning rate as a multiple of the networks'
   // (a per-group rate: the codes' Adam steps are scaled by it). 1: one rate.
   double code_lr_scale = 1;
-  double template_share = 0;  // share of the run's cost spent on the template (when template_steps < 0)
+  // Share of the run's cost spent on the template (when template_steps < 0).
+  // `jsatlas fit` starts collections with -1 and 0.3 (docs/collections.md).
+  double template_share = 0;
 };
 
 // `--preset paper`: the paper's configuration (Sec. 3, implementation details)
@@ -100,6 +102,8 @@ inline void apply_paper_preset(FitOptions& o) {
   o.atlas.alpha = 0.01;
   o.points = 10000;
   o.weights.cycle = LossWeights{}.cycle;  // the paper's lambda_cycle (mean convention)
+  o.template_steps = 0;                   // the paper trains all shapes jointly from the start
+  o.align_poses = false;                  // and takes the shapes in the poses given
 }
 
 inline FitOptions paper_fit_options() {
@@ -119,7 +123,8 @@ struct NumericalFault : std::runtime_error {
   using std::runtime_error::runtime_error;
   NumericalFault(int faults_in_a_row, int64_t iteration)
       : std::runtime_error("training diverged: NaN/Inf " + std::to_string(faults_in_a_row) +
-                           " times in a row at iteration " + std::to_string(iteration) + " (try a smaller --lr)") {}
+                           " times in a row at iteration " + std::to_string(iteration) +
+                           " (try a smaller --lr)") {}
 };
 
 class Trainer {
@@ -151,7 +156,7 @@ class Trainer {
   void set_template_steps(int64_t n) { options_.template_steps = n; }
   double learning_rate() const;  // the schedule at the current iteration, times the fault scale
   int faults() const { return faults_total_; }
-  int mirrors() const { return mirrors_; }  // times the domain was mirrored (model/orientation.h)
+  int mirrors() const { return mirrors_; }    // times the domain was mirrored (model/orientation.h)
   int reseeded() const { return reseeded_; }  // Gaussians moved so far (model/reseed.h)
   // Test hook: the next `count` attempts at `iteration` see a NaN loss.
   void inject_faults(int64_t iteration, int count) {
@@ -173,7 +178,7 @@ class Trainer {
 
  private:
   FitOptions options_;
-  std::vector<Block<float>> pools_;  // per shape P x 6, normals scaled by alpha
+  std::vector<Block<float>> pools_;            // per shape P x 6, normals scaled by alpha
   std::vector<NearestIndex<float>> surfaces_;  // per shape, over its pool (dense L_6D only)
   std::unique_ptr<Atlas<float>> atlas_;
   Adam<float> adam_;
@@ -183,7 +188,7 @@ class Trainer {
   LossTerms last_;
   std::vector<Block<float>> targets_;  // per shape of the step's batch
   std::vector<int> batch_;             // the shapes of the step (all N without batching)
-  std::vector<int> batch_step_;        // the shapes of the last step taken (targets_ belong to them)
+  std::vector<int> batch_step_;  // the shapes of the last step taken (targets_ belong to them)
   // The last good state, refreshed every kSnapshotEvery iterations.
   static constexpr int64_t kSnapshotEvery = 50;
   std::vector<float> good_params_, good_m_, good_v_;
@@ -195,7 +200,7 @@ class Trainer {
   int mirrors_ = 0;
   int reseeded_ = 0;
   bool wrapped_ = false;
-  int64_t template_done_ = 0;      // template steps taken
+  int64_t template_done_ = 0;  // template steps taken
   bool template_finished_ = false;
   void take_snapshot();
   // One Adam step on the shapes of `batch` at rate lr; false if a NaN/Inf was caught.

@@ -60,11 +60,13 @@ TEST_CASE("rigid_align never reflects, and is deterministic", "[model][rigid_ali
   mirrored.col(0) *= -1;
   const jsa::RigidAlignment m = jsa::rigid_align(mirrored, fixed);
   CHECK(m.rotation.determinant() == Approx(1).margin(1e-9));
-  CHECK((m.rotation * m.rotation.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-9);
+  CHECK((m.rotation * m.rotation.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <
+        1e-9);
 
   jsa::Rng rng(9);
   const jsa::Block<double> moving = lumpy(2000, 5) * random_rotation(rng);
-  const jsa::RigidAlignment a = jsa::rigid_align(moving, fixed), b = jsa::rigid_align(moving, fixed);
+  const jsa::RigidAlignment a = jsa::rigid_align(moving, fixed),
+                            b = jsa::rigid_align(moving, fixed);
   CHECK(a.rotation == b.rotation);
   CHECK(a.chamfer == b.chamfer);
 }
@@ -80,7 +82,8 @@ TEST_CASE("close eigenvalues add the axis orders as candidates", "[model][rigid_
     for (jsa::Index i = 0; i < n; ++i) {
       Eigen::RowVector3d d(rng.normal(), rng.normal(), rng.normal());
       d.normalize();
-      p.row(i) = (1 + 0.4 * std::exp(-8 * (d - bump).squaredNorm())) * Eigen::RowVector3d(d(0), 0.97 * d(1), 0.5 * d(2));
+      p.row(i) = (1 + 0.4 * std::exp(-8 * (d - bump).squaredNorm())) *
+                 Eigen::RowVector3d(d(0), 0.97 * d(1), 0.5 * d(2));
     }
     p.rowwise() -= p.colwise().mean();
     return p;

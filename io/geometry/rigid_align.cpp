@@ -75,8 +75,10 @@ double RigidAlignment::angle_degrees() const { return rotation_angle_degrees(rot
 RigidAlignment rigid_align(const Block<double>& moving_all, const Block<double>& fixed_all,
                            const RigidAlignOptions& o) {
   JSA_CHECK(moving_all.cols() == 3 && fixed_all.cols() == 3, "rigid_align takes N x 3 points");
-  JSA_CHECK(moving_all.rows() >= 4 && fixed_all.rows() >= 4, "rigid_align needs at least 4 points per set");
-  JSA_CHECK(o.samples >= 4 && o.icp_iterations >= 0 && o.final_iterations >= 0, "bad rigid_align options");
+  JSA_CHECK(moving_all.rows() >= 4 && fixed_all.rows() >= 4,
+            "rigid_align needs at least 4 points per set");
+  JSA_CHECK(o.samples >= 4 && o.icp_iterations >= 0 && o.final_iterations >= 0,
+            "bad rigid_align options");
   const Block<double> moving = moving_all.topRows(std::min(o.samples, moving_all.rows()));
   const Block<double> fixed = fixed_all.topRows(std::min(o.samples, fixed_all.rows()));
   const NearestIndex<double> moving_index(moving), fixed_index(fixed);
@@ -101,7 +103,8 @@ RigidAlignment rigid_align(const Block<double>& moving_all, const Block<double>&
   std::vector<Eigen::Matrix3d> candidates;
   do {
     bool allowed = true;
-    for (int a = 0; a < 3; ++a) allowed = allowed && (perm[size_t(a)] == a || close(a, perm[size_t(a)]));
+    for (int a = 0; a < 3; ++a)
+      allowed = allowed && (perm[size_t(a)] == a || close(a, perm[size_t(a)]));
     if (!allowed) continue;
     for (int signs = 0; signs < 8; ++signs) {
       Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
@@ -122,6 +125,8 @@ RigidAlignment rigid_align(const Block<double>& moving_all, const Block<double>&
     }
     return r;
   };
+  // The input's own pose first.
+  candidates.insert(candidates.begin(), Eigen::Matrix3d::Identity());
   std::vector<Eigen::Matrix3d> refined;
   std::vector<double> scores;
   for (const Eigen::Matrix3d& start : candidates) {
@@ -132,6 +137,11 @@ RigidAlignment rigid_align(const Block<double>& moving_all, const Block<double>&
   for (size_t c = 1; c < scores.size(); ++c)
     if (scores[c] < scores[best]) best = c;
   RigidAlignment out;
+  out.input_chamfer = scores[0];
+  if (best != 0 && o.keep_input > 0 && scores[0] <= o.keep_input * scores[best]) {
+    best = 0;
+    out.kept_input = true;
+  }
   out.rotation = icp(refined[best], o.final_iterations);
   out.chamfer = chamfer_and_update(sets, out.rotation, nullptr);
   out.candidates = int(candidates.size());

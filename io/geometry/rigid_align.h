@@ -11,8 +11,11 @@
 //   3. each candidate refined by point-to-point ICP, rotation only (Kabsch on
 //      the nearest pairs of both directions);
 //   4. the refined candidate with the lowest symmetric Chamfer distance wins;
-//      ties keep the earlier candidate (the fixed order above, identity first);
-//      it gets more ICP steps, until the rotation stops changing.
+//      ties keep the earlier candidate (the fixed order above, identity first),
+//      except that ICP from the input's own pose wins when it is within
+//      `keep_input` of the best (families of shapes are often stored aligned,
+//      and near-symmetric ones, like an ant end to end, score two poses alike);
+//      the winner gets more ICP steps, until the rotation stops changing.
 // Symmetric shapes: a mirror is never a candidate (det = +1), so a left/right
 // symmetric shape cannot come out reflected; a shape with a front/back or
 // top/bottom symmetry has two candidates of about the same Chamfer, and the
@@ -30,13 +33,19 @@ struct RigidAlignOptions {
   int final_iterations = 500;  // more ICP steps for the winner (point-to-point ICP slides slowly
                                // along directions a near-symmetric shape hardly pins)
   double close_eigenvalues = 0.15;  // relative gap |l_a - l_b| / l_a under which axes a, b may swap
+  // The input's own pose (ICP started at the identity) is kept when its Chamfer
+  // is within this factor of the best candidate's: a collection stored aligned
+  // stays as it is unless another pose is clearly better (0: always the best).
+  double keep_input = 1.25;
 };
 
 struct RigidAlignment {
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // rows: moving x -> x * rotation ~ fixed
-  double chamfer = 0;          // symmetric Chamfer (mean squared distance, both ways) after ICP
-  double runner_up = 0;        // the best Chamfer of a candidate that ends > 10 degrees away
-  int candidates = 0;          // rotations tried
+  double chamfer = 0;            // symmetric Chamfer (mean squared distance, both ways) after ICP
+  double runner_up = 0;          // the best Chamfer of a candidate that ends > 10 degrees away
+  int candidates = 0;            // rotations tried (the input's pose and the axis candidates)
+  double input_chamfer = 0;      // ICP from the input's own pose
+  bool kept_input = false;       // the input's pose won by the keep_input rule
   double angle_degrees() const;  // of `rotation`
 };
 
