@@ -74,7 +74,7 @@ TEST_CASE("rigid_align never reflects, and is deterministic", "[model][rigid_ali
 TEST_CASE("close eigenvalues add the axis orders as candidates", "[model][rigid_align]") {
   // Radii 1, 0.97, 0.5 and a bump between the first two axes: their eigenvalues
   // are within a few percent, so the axes' order is not defined and more than
-  // the 4 sign candidates are tried; the pose is still found.
+  // the 4 sign candidates (and the input pose) are tried; the pose is still found.
   jsa::Rng rng(2);
   const Eigen::RowVector3d bump = Eigen::RowVector3d(0.5, 0.5, 0.7).normalized();
   auto round = [&](jsa::Index n) {
@@ -91,10 +91,31 @@ TEST_CASE("close eigenvalues add the axis orders as candidates", "[model][rigid_
   const jsa::Block<double> fixed = round(3000), sample = round(3000);
   const Eigen::Matrix3d a = random_rotation(rng);
   const jsa::RigidAlignment r = jsa::rigid_align(sample * a, fixed);
-  CHECK(r.candidates > 4);
+  CHECK(r.candidates > 5);
   // Only the bump pins the turn about the short axis, so two independent
   // samples agree on it to a few degrees (3.1 here), not to the 2 above.
   CHECK(jsa::rotation_angle_degrees(r.rotation.transpose() * a.transpose()) < 5.0);
   const jsa::RigidAlignment distinct = jsa::rigid_align(lumpy(2000, 6), lumpy(2000, 7));
-  CHECK(distinct.candidates == 4);
+  CHECK(distinct.candidates == 5);  // the input's pose and the 4 sign candidates
+}
+
+TEST_CASE("a shape already in the pose of the first keeps it", "[model][rigid_align]") {
+  // An ellipsoid without the bump is symmetric under half turns about its
+  // axes: four poses score alike. Given in the right pose, the input's own is
+  // kept rather than whichever symmetric candidate happens to score lowest.
+  jsa::Rng rng(4);
+  auto ellipsoid = [&](jsa::Index n) {
+    jsa::Block<double> p(n, 3);
+    for (jsa::Index i = 0; i < n; ++i) {
+      Eigen::RowVector3d d(rng.normal(), rng.normal(), rng.normal());
+      d.normalize();
+      p.row(i) = Eigen::RowVector3d(d(0), 0.6 * d(1), 0.35 * d(2));
+    }
+    p.rowwise() -= p.colwise().mean();
+    return p;
+  };
+  const jsa::Block<double> fixed = ellipsoid(2000), moving = ellipsoid(2000);
+  const jsa::RigidAlignment r = jsa::rigid_align(moving, fixed);
+  CHECK(r.input_chamfer <= 1.25 * r.chamfer);
+  CHECK(r.angle_degrees() < 5.0);
 }
