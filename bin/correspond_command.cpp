@@ -5,15 +5,14 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "bin/commands.h"
 #include "engine/parallel.h"
 #include "io/atomic_write.h"
-#include "io/keypoints.h"
 #include "io/geometry/nearest.h"
+#include "io/keypoints.h"
 #include "model/tool/checkpoint.h"
 #include "model/tool/correspondence.h"
 #include "model/tool/fit_config.h"
@@ -59,7 +58,8 @@ Block<double> read_points(const std::string& path) {
     if (!(s >> first) || first[0] == '#') continue;
     std::istringstream s2(line);
     if (!(s2 >> x >> y >> z) || !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z))
-      throw InputError(path + ":" + std::to_string(lineno) + ": expected three finite numbers x y z");
+      throw InputError(path + ":" + std::to_string(lineno) +
+                       ": expected three finite numbers x y z");
     rows.emplace_back(x, y, z);
   }
   if (rows.empty()) throw InputError(path + ": no points");
@@ -91,7 +91,8 @@ void run_correspond(const CorrespondArgs& a) {
     for (size_t k = 0; k < a.vertices.size(); ++k) {
       if (a.vertices[k] < 0 || a.vertices[k] >= source.vertices.rows())
         throw InputError("--vertices: " + std::to_string(a.vertices[k]) + " is not a vertex of " +
-                         r.contents.inputs[size_t(a.from)] + " (" + std::to_string(source.vertices.rows()) + " vertices)");
+                         r.contents.inputs[size_t(a.from)] + " (" +
+                         std::to_string(source.vertices.rows()) + " vertices)");
       p.row(Index(k)) = source.vertices.row(a.vertices[k]);
       pn.row(Index(k)) = source_normals.row(a.vertices[k]);
     }
@@ -107,7 +108,8 @@ void run_correspond(const CorrespondArgs& a) {
   }
   CorrespondenceOptions co;
   co.use_chart = r.options.components.chart && !a.nearest_rule;
-  const Block<double> q = fj.from_unit(correspond(*r.atlas, a.from, a.to, fi.to_unit(p), pn, co));
+  const Block<double> q =
+      fj.from_unit(correspond(*r.atlas, a.from, a.to, fi.to_unit(p), fi.normals_to_unit(pn), co));
   std::vector<int> snapped;
   if (a.snap) {
     const Mesh target = load_shape(r.contents.inputs[size_t(a.to)]);
@@ -115,41 +117,46 @@ void run_correspond(const CorrespondArgs& a) {
   }
   std::ostringstream out;
   out.precision(9);
-  out << "# x y z on shape " << a.to << " (" << r.contents.inputs[size_t(a.to)] << "), its own frame"
-      << (a.snap ? "; nearest vertex index" : "") << "\n";
+  out << "# x y z on shape " << a.to << " (" << r.contents.inputs[size_t(a.to)]
+      << "), its own frame" << (a.snap ? "; nearest vertex index" : "") << "\n";
   for (Index i = 0; i < q.rows(); ++i) {
     out << q(i, 0) << " " << q(i, 1) << " " << q(i, 2);
     if (a.snap) out << " " << snapped[size_t(i)];
     out << "\n";
   }
-  if (a.out.empty()) std::cout << out.str();
-  else write_file_atomically(a.out, [&](std::ostream& f) { f << out.str(); });
+  if (a.out.empty())
+    std::cout << out.str();
+  else
+    write_file_atomically(a.out, [&](std::ostream& f) { f << out.str(); });
 }
 
 struct EvalCorrArgs {
   std::string run;
   std::vector<std::string> keypoints;
   bool nearest_rule = false;
-  int threads = 0;
+  int threads = 0, refine = 0;
 };
 
 void run_eval_corr(const EvalCorrArgs& a) {
   set_threads(a.threads);
   Run r = open_run(a.run);
   const size_t n = r.contents.inputs.size();
-  if (n < 2) throw InputError("eval-corr: the run has one shape; correspondences need a collection");
+  if (n < 2)
+    throw InputError("eval-corr: the run has one shape; correspondences need a collection");
   std::vector<std::string> files;
   if (a.keypoints.size() == 1 && fs::is_directory(a.keypoints[0])) {
     for (const std::string& input : r.contents.inputs) {
       const fs::path f = fs::path(a.keypoints[0]) / (fs::path(input).stem().string() + ".vts");
-      if (!fs::exists(f)) throw InputError("eval-corr: no keypoint file " + f.string() + " for " + input);
+      if (!fs::exists(f))
+        throw InputError("eval-corr: no keypoint file " + f.string() + " for " + input);
       files.push_back(f.string());
     }
   } else {
     files = a.keypoints;
   }
   if (files.size() != n)
-    throw InputError("eval-corr: " + std::to_string(files.size()) + " keypoint files for " + std::to_string(n) +
+    throw InputError("eval-corr: " + std::to_string(files.size()) + " keypoint files for " +
+                     std::to_string(n) +
                      " shapes (give one per shape, in the run's order, or a directory)");
   std::vector<Mesh> meshes;
   std::vector<std::vector<int>> keypoints;
@@ -159,15 +166,22 @@ void run_eval_corr(const EvalCorrArgs& a) {
   }
   CorrespondenceOptions co;
   co.use_chart = r.options.components.chart && !a.nearest_rule;
-  const KeypointError e = keypoint_error(*r.atlas, meshes, r.contents.normalizations, keypoints, co);
-  std::printf("correspondence error over %lld ordered pairs x %lld keypoints (%s)\n", (long long)e.pairs,
-              (long long)e.keypoints, co.use_chart ? "q = phi_J(psi_I(p))" : "nearest-sample rule, no chart");
+  co.refine_steps = a.refine;
+  const KeypointError e =
+      keypoint_error(*r.atlas, meshes, r.contents.normalizations, keypoints, co);
+  const std::string rule = !co.use_chart         ? "nearest-sample rule, no chart"
+                           : co.refine_steps > 0 ? "q = phi_J(u), u = psi_I(p) refined by " +
+                                                       std::to_string(co.refine_steps) + " steps"
+                                                 : "q = phi_J(psi_I(p))";
+  std::printf("correspondence error over %lld ordered pairs x %lld keypoints (%s)\n",
+              (long long)e.pairs, (long long)e.keypoints, rule.c_str());
   std::printf("  mean L2 in the target's unit frame: %.3f x 1e-2\n", 100 * e.mean);
   for (size_t t = 0; t < e.thresholds.size(); ++t)
     std::printf("  within %.2f: %5.1f%%\n", e.thresholds[t], 100 * e.within[t]);
   nlohmann::json j;
   j["run"] = a.run;
   j["rule"] = co.use_chart ? "chart" : "nearest-sample";
+  j["refine_steps"] = co.use_chart ? co.refine_steps : 0;
   j["mean_l2_unit_frame"] = e.mean;
   j["mean_l2_x1e-2"] = 100 * e.mean;
   j["pairs"] = e.pairs;
@@ -176,7 +190,8 @@ void run_eval_corr(const EvalCorrArgs& a) {
   j["within"] = e.within;
   j["pair_mean"] = e.pair_mean;
   j["keypoint_files"] = files;
-  write_file_atomically(a.run + "/eval_corr.json", [&](std::ostream& out) { out << j.dump(2) << "\n"; });
+  write_file_atomically(a.run + "/eval_corr.json",
+                        [&](std::ostream& out) { out << j.dump(2) << "\n"; });
   std::printf("written: %s/eval_corr.json\n", a.run.c_str());
 }
 
@@ -184,26 +199,45 @@ void run_eval_corr(const EvalCorrArgs& a) {
 
 void add_correspond(CLI::App& app) {
   auto a = std::make_shared<CorrespondArgs>();
-  CLI::App* c = app.add_subcommand("correspond", "Carry points from shape I to shape J of a collection: q = phi_J(psi_I(p))");
+  CLI::App* c = app.add_subcommand(
+      "correspond", "Carry points from shape I to shape J of a collection: q = phi_J(psi_I(p))");
   c->add_option("run", a->run, "Run directory of a collection fit")->required();
-  c->add_option("points", a->points_file, "File of points on shape I (x y z per line, I's own frame)");
+  c->add_option("points", a->points_file,
+                "File of points on shape I (x y z per line, I's own frame)");
   c->add_option("--from", a->from, "Source shape I (0-based)")->capture_default_str();
   c->add_option("--to", a->to, "Target shape J (0-based)")->capture_default_str();
-  c->add_option("--vertices", a->vertices, "Vertex indices of shape I's input mesh instead of a points file")->delimiter(',');
+  c->add_option("--vertices", a->vertices,
+                "Vertex indices of shape I's input mesh instead of a points file")
+      ->delimiter(',');
   c->add_flag("--snap", a->snap, "Also print the nearest vertex of J's input mesh");
-  c->add_flag("--nearest-rule", a->nearest_rule, "Use the paper's nearest-sample rule instead of the chart psi");
+  c->add_flag("--nearest-rule", a->nearest_rule,
+              "Use the paper's nearest-sample rule instead of the chart psi");
   c->add_option("-o,--out", a->out, "Write the points to this file instead of standard output");
-  c->add_option("--threads", a->threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
+  c->add_option("--threads", a->threads, "Threads (0: all cores)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1024));
   c->callback([a]() { run_correspond(*a); });
 }
 
 void add_eval_corr(CLI::App& app) {
   auto a = std::make_shared<EvalCorrArgs>();
-  CLI::App* c = app.add_subcommand("eval-corr", "Correspondence error on SHREC .vts keypoints (paper Table 1, Corresp. L2)");
+  CLI::App* c = app.add_subcommand(
+      "eval-corr", "Correspondence error on SHREC .vts keypoints (paper Table 1, Corresp. L2)");
   c->add_option("run", a->run, "Run directory of a collection fit")->required();
-  c->add_option("--keypoints", a->keypoints, "A directory holding <input stem>.vts for each shape, or one .vts per shape in order")->required();
-  c->add_flag("--nearest-rule", a->nearest_rule, "Use the nearest-sample rule even if the run has a chart");
-  c->add_option("--threads", a->threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
+  c->add_option(
+       "--keypoints", a->keypoints,
+       "A directory holding <input stem>.vts for each shape, or one .vts per shape in order")
+      ->required();
+  c->add_flag("--nearest-rule", a->nearest_rule,
+              "Use the nearest-sample rule even if the run has a chart");
+  c->add_option("--refine", a->refine,
+                "Chart rule: Gauss-Newton steps moving psi_I(p) to the nearest point of phi_I "
+                "before phi_J (0: psi alone, the paper)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000));
+  c->add_option("--threads", a->threads, "Threads (0: all cores)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1024));
   c->callback([a]() { run_eval_corr(*a); });
 }
 

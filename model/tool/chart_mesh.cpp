@@ -6,12 +6,14 @@ namespace jsa {
 namespace {
 
 // Rows [x, alpha n] of the chart's input, in the unit frame.
-Block<double> chart_input(const Atlas<float>& atlas, const Mesh& mesh, const Normalization& normalization) {
-  Block<double> normals = mesh.has_normals() ? mesh.normals
-                                             : area_weighted_vertex_normals(mesh.vertices, mesh.faces);
+Block<double> chart_input(const Atlas<float>& atlas, const Mesh& mesh,
+                          const Normalization& normalization) {
+  Block<double> normals =
+      mesh.has_normals() ? mesh.normals : area_weighted_vertex_normals(mesh.vertices, mesh.faces);
   Block<double> in(mesh.vertices.rows(), 6);
   in.leftCols(3) = normalization.to_unit(mesh.vertices);
-  in.rightCols(3) = atlas.options().alpha * normals.rowwise().normalized();
+  in.rightCols(3) =
+      atlas.options().alpha * normalization.normals_to_unit(normals).rowwise().normalized();
   return in;
 }
 
@@ -31,8 +33,8 @@ Block<double> chart_points(Atlas<float>& atlas, const Block<double>& x, int shap
   return uv;
 }
 
-Block<double> chart_vertices(Atlas<float>& atlas, const Mesh& mesh, const Normalization& normalization,
-                             int shape) {
+Block<double> chart_vertices(Atlas<float>& atlas, const Mesh& mesh,
+                             const Normalization& normalization, int shape) {
   if (mesh.vertices.rows() == 0) throw InputError("chart: the mesh has no vertices");
   return chart_points(atlas, chart_input(atlas, mesh, normalization), shape);
 }

@@ -14,9 +14,14 @@
 namespace jsa {
 
 struct CorrespondenceOptions {
-  bool use_chart = true;        // false: the nearest-sample rule (no psi)
+  bool use_chart = true;          // false: the nearest-sample rule (no psi)
   Index nearest_samples = 20000;  // samples of P for the nearest-sample rule
   uint64_t seed = 0;
+  // Chart rule: damped Gauss-Newton steps that move u = psi_I(p) to the nearest
+  // point of phi_I(u) to p before mapping by phi_J (0: psi alone, the paper's rule).
+  // psi is trained to invert phi; these steps finish the inversion it has not
+  // reached (beyond the paper; docs/collections.md).
+  int refine_steps = 0;
 };
 
 // p_unit: N x 3 points and n: N x 3 unit normals on shape `from`, in its unit
@@ -28,8 +33,8 @@ Block<double> correspond(Atlas<float>& atlas, int from, int to, const Block<doub
 Block<double> vertex_normals_of(const Mesh& mesh);
 
 struct KeypointError {
-  double mean = 0;                // mean |q - q_gt| over all ordered pairs, unit frame of the target
-  std::vector<double> within;     // fraction of keypoints within each threshold
+  double mean = 0;             // mean |q - q_gt| over all ordered pairs, unit frame of the target
+  std::vector<double> within;  // fraction of keypoints within each threshold
   std::vector<double> thresholds;
   Index pairs = 0, keypoints = 0;
   std::vector<std::vector<double>> pair_mean;  // [I][J] mean error (0 on the diagonal)
@@ -52,7 +57,8 @@ KeypointError keypoint_error(const CorrespondenceMap& map, const std::vector<Mes
 // The same for a joint atlas, its map being correspond() above.
 KeypointError keypoint_error(Atlas<float>& atlas, const std::vector<Mesh>& meshes,
                              const std::vector<Normalization>& frames,
-                             const std::vector<std::vector<int>>& keypoints, const CorrespondenceOptions& o,
+                             const std::vector<std::vector<int>>& keypoints,
+                             const CorrespondenceOptions& o,
                              const std::vector<double>& thresholds = {0.01, 0.02, 0.05, 0.1});
 
 }  // namespace jsa
