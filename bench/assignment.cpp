@@ -9,7 +9,6 @@
 // Times n/4, n/2 and n points; per size, the median of R runs of the cost
 // matrix (parallel) and of the LAPJV solve (serial), on the same sets each run
 // (every run must return the same matching).
-#include "bench/timing.h"
 #include "losses/metrics/assignment.h"
 
 #include <algorithm>
@@ -21,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/timing.h"
 #include "engine/check.h"
 #include "engine/parallel.h"
 #include "engine/rng.h"
@@ -29,9 +29,9 @@
 
 namespace {
 
+using bench::Clock;
 using jsa::Block;
 using jsa::Index;
-using bench::Clock;
 
 using bench::median;
 using bench::seconds_since;

@@ -16,6 +16,8 @@
 //            (the CSV's step_ms is the M-to-M step, the work the PyTorch
 //            peers do; dense_step_ms the default's)
 // Each kernel is validated against its oracle before it is timed.
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -23,14 +25,13 @@
 #include <fstream>
 #include <functional>
 #include <string>
-#include <sys/resource.h>
 #include <vector>
 
 #include "engine/ops.h"
 #include "engine/parallel.h"
 #include "engine/tangents.h"
-#include "losses/chamfer.h"
 #include "io/geometry/nearest.h"
+#include "losses/chamfer.h"
 #include "losses/repulsion.h"
 #include "model/tool/trainer.h"
 
@@ -58,7 +59,9 @@ Block<float> random_block(Index n, Index c, Rng& rng, double scale = 1) {
 }
 
 // Forward + backward FLOPs of an MLP on `rows` rows (first layer has no dX).
-double mlp_flops(const Mlp<float>& mlp, Index rows) { return 3.0 * mlp.flops(rows) - 2.0 * rows * mlp.shape().in * mlp.shape().width; }
+double mlp_flops(const Mlp<float>& mlp, Index rows) {
+  return 3.0 * mlp.flops(rows) - 2.0 * rows * mlp.shape().in * mlp.shape().width;
+}
 
 // The same GEMMs as an MLP step, in plain Eigen: Y = X W, dW = X^T dY, dX = dY W^T,
 // into preallocated outputs (noalias), so the bound is the GEMM kernels alone.
@@ -91,21 +94,32 @@ int main(int argc, char** argv) {
   int threads = 0, runs = 5;
   std::string csv;
   for (int i = 1; i < argc + (argc % 2 == 0 ? 1 : 0); ++i)
-    if (i == argc || std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {  // help, or a flag without its value
-      std::printf("usage: bench_iteration [--points M] [--gaussians K] [--width W] [--depth D] [--softplus BETA] [--threads T] [--runs R] [--csv FILE]\n");
+    if (i == argc || std::string(argv[i]) == "--help" ||
+        std::string(argv[i]) == "-h") {  // help, or a flag without its value
+      std::printf(
+          "usage: bench_iteration [--points M] [--gaussians K] [--width W] [--depth D] [--softplus "
+          "BETA] [--threads T] [--runs R] [--csv FILE]\n");
       return i == argc ? 2 : 0;
     }
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string f = argv[i];
     const long v = std::atol(argv[i + 1]);
-    if (f == "--points") o.points = v;
-    else if (f == "--gaussians") o.atlas.gaussians = int(v);
-    else if (f == "--width") o.atlas.width = int(v);
-    else if (f == "--depth") o.atlas.hidden_layers = int(v);
-    else if (f == "--softplus") o.atlas.softplus_beta = std::atof(argv[i + 1]);
-    else if (f == "--threads") threads = int(v);
-    else if (f == "--runs") runs = int(v);
-    else if (f == "--csv") csv = argv[i + 1];
+    if (f == "--points")
+      o.points = v;
+    else if (f == "--gaussians")
+      o.atlas.gaussians = int(v);
+    else if (f == "--width")
+      o.atlas.width = int(v);
+    else if (f == "--depth")
+      o.atlas.hidden_layers = int(v);
+    else if (f == "--softplus")
+      o.atlas.softplus_beta = std::atof(argv[i + 1]);
+    else if (f == "--threads")
+      threads = int(v);
+    else if (f == "--runs")
+      runs = int(v);
+    else if (f == "--csv")
+      csv = argv[i + 1];
     else {
       std::fprintf(stderr, "unknown flag %s\n", f.c_str());
       return 2;
@@ -130,10 +144,14 @@ int main(int argc, char** argv) {
     const double cut = repulsion_cutoff<float>(mu, 1.0f / std::sqrt(2000.0f), nullptr);
     const double exact = repulsion_exact<float>(mu, 1.0f / std::sqrt(2000.0f), nullptr);
     if (fast != slow || std::abs(cut - exact) > 1e-5 * exact) {
-      std::fprintf(stderr, "validation failed: nearest %s, repulsion %g vs %g\n", fast == slow ? "ok" : "differs", cut, exact);
+      std::fprintf(stderr, "validation failed: nearest %s, repulsion %g vs %g\n",
+                   fast == slow ? "ok" : "differs", cut, exact);
       return 1;
     }
-    std::printf("validated: nearest == brute force (2000 x 2000, 6D); repulsion cut-off %.9g vs exact %.9g\n", cut, exact);
+    std::printf(
+        "validated: nearest == brute force (2000 x 2000, 6D); repulsion cut-off %.9g vs exact "
+        "%.9g\n",
+        cut, exact);
   }
 
   // A pool on the unit sphere is enough to time: the cost does not depend on the shape.
@@ -203,8 +221,9 @@ int main(int argc, char** argv) {
   struct rusage ru;
   getrusage(RUSAGE_SELF, &ru);
 
-  std::printf("\nfull method, M = %lld, K = %d, MLPs %dx%d, threads = %d, median of %d\n", (long long)m,
-              o.atlas.gaussians, o.atlas.hidden_layers, o.atlas.width, max_threads(), runs);
+  std::printf("\nfull method, M = %lld, K = %d, MLPs %dx%d, threads = %d, median of %d\n",
+              (long long)m, o.atlas.gaussians, o.atlas.hidden_layers, o.atlas.width, max_threads(),
+              runs);
   std::printf("  %-34s %9s\n", "piece", "ms");
   std::printf("  %-34s %9.1f\n", "phi + Jacobians, 2M points (f+b)", phi_ms);
   std::printf("  %-34s %9.1f\n", "psi, 2M points (f+b)", psi_ms);
@@ -214,20 +233,25 @@ int main(int argc, char** argv) {
   std::printf("  %-34s %9.1f\n", "Adam", adam_ms);
   std::printf("  %-34s %9.1f\n", "one training step (all)", step_ms);
   std::printf("  %-34s %9.1f   (the dense L_6D step costs x%.2f the M-to-M one)\n",
-              o.dense_surface ? "same, M-to-M L_6D (Eq. 7)" : "same, dense L_6D", other_ms, dense_ms / sparse_ms);
-  std::printf("  MLP work %.1f GFLOP: %.0f GFLOP/s in the step's MLPs (phi+psi pieces), SGEMM of the same shapes "
-              "%.1f ms = %.0f GFLOP/s (ratio %.0f%%)\n",
-              flops * 1e-9, flops * 1e-6 / (phi_ms + psi_ms), gemm_ms, flops * 1e-6 / gemm_ms,
-              100.0 * gemm_ms / (phi_ms + psi_ms));
+              o.dense_surface ? "same, M-to-M L_6D (Eq. 7)" : "same, dense L_6D", other_ms,
+              dense_ms / sparse_ms);
+  std::printf(
+      "  MLP work %.1f GFLOP: %.0f GFLOP/s in the step's MLPs (phi+psi pieces), SGEMM of the same "
+      "shapes "
+      "%.1f ms = %.0f GFLOP/s (ratio %.0f%%)\n",
+      flops * 1e-9, flops * 1e-6 / (phi_ms + psi_ms), gemm_ms, flops * 1e-6 / gemm_ms,
+      100.0 * gemm_ms / (phi_ms + psi_ms));
   std::printf("  peak resident memory %.0f MB\n", ru.ru_maxrss / 1024.0);
   if (!csv.empty()) {
     const bool fresh = !std::ifstream(csv).good();
     std::ofstream out(csv, std::ios::app);
-    if (fresh) out << "points,gaussians,width,depth,threads,phi_ms,psi_ms,chamfer6_ms,chamfer2_ms,repulsion_ms,adam_ms,step_ms,gemm_ms,gflop,peak_mb,dense_step_ms\n";
-    out << m << "," << o.atlas.gaussians << "," << o.atlas.width << "," << o.atlas.hidden_layers << ","
-        << max_threads() << "," << phi_ms << "," << psi_ms << "," << ch6_ms << "," << ch2_ms << "," << rep_ms
-        << "," << adam_ms << "," << sparse_ms << "," << gemm_ms << "," << flops * 1e-9 << ","
-        << ru.ru_maxrss / 1024.0 << "," << dense_ms << "\n";
+    if (fresh)
+      out << "points,gaussians,width,depth,threads,phi_ms,psi_ms,chamfer6_ms,chamfer2_ms,repulsion_"
+             "ms,adam_ms,step_ms,gemm_ms,gflop,peak_mb,dense_step_ms\n";
+    out << m << "," << o.atlas.gaussians << "," << o.atlas.width << "," << o.atlas.hidden_layers
+        << "," << max_threads() << "," << phi_ms << "," << psi_ms << "," << ch6_ms << "," << ch2_ms
+        << "," << rep_ms << "," << adam_ms << "," << sparse_ms << "," << gemm_ms << ","
+        << flops * 1e-9 << "," << ru.ru_maxrss / 1024.0 << "," << dense_ms << "\n";
   }
   return 0;
 }

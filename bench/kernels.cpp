@@ -31,11 +31,11 @@
 #include "bench/timing.h"
 #include "engine/parallel.h"
 #include "engine/rng.h"
+#include "io/geometry/nearest.h"
+#include "losses/chamfer.h"
 #include "losses/metrics/assignment.h"
 #include "losses/metrics/assignment_auction.h"
-#include "losses/chamfer.h"
 #include "losses/metrics/emd.h"
-#include "io/geometry/nearest.h"
 #include "losses/repulsion.h"
 
 namespace {
@@ -68,15 +68,22 @@ Options parse(int argc, char** argv) {
         throw std::runtime_error(a + ": expected an integer in [1, 1000000], got '" + value + "'");
       return int(v);
     };
-    if (a == "--points") o.points = number();
-    else if (a == "--gaussians") o.gaussians = number();
-    else if (a == "--n") o.n = number();
-    else if (a == "--runs") o.runs = number();
-    else if (a == "--threads") o.threads = number();
-    else if (a == "--dump") o.dump = value;
+    if (a == "--points")
+      o.points = number();
+    else if (a == "--gaussians")
+      o.gaussians = number();
+    else if (a == "--n")
+      o.n = number();
+    else if (a == "--runs")
+      o.runs = number();
+    else if (a == "--threads")
+      o.threads = number();
+    else if (a == "--dump")
+      o.dump = value;
     else
-      throw std::runtime_error("unknown flag '" + a +
-                               "' (flags: --points N --gaussians K --n N' --runs R --threads T --dump DIR)");
+      throw std::runtime_error(
+          "unknown flag '" + a +
+          "' (flags: --points N --gaussians K --n N' --runs R --threads T --dump DIR)");
   }
   return o;
 }
@@ -93,7 +100,8 @@ double median_seconds(int runs, const std::function<void()>& f) {
   return median(t);
 }
 
-// n rows [p, alpha p] with p uniform on the unit sphere, p pushed off it by N(0, noise^2) per coordinate.
+// n rows [p, alpha p] with p uniform on the unit sphere, p pushed off it by N(0, noise^2) per
+// coordinate.
 Block<float> sphere6(Index n, double noise, jsa::Rng& rng) {
   Block<float> b(n, 6);
   for (Index i = 0; i < n; ++i) {
@@ -128,8 +136,8 @@ void write_matrix(const std::string& path, const Block<T>& m) {
 
 // Chamfer of x and y: nearest() against brute force both ways, then timed.
 // Returns {value, median seconds}.
-std::pair<double, double> chamfer_kernel(const char* name, const Block<float>& x, const Block<float>& y,
-                                         int runs) {
+std::pair<double, double> chamfer_kernel(const char* name, const Block<float>& x,
+                                         const Block<float>& y, int runs) {
   jsa::ChamferMatches<float> m;
   const double value = jsa::chamfer_distance(x, y, &m);
   std::vector<int> x_to_y, y_to_x;
@@ -151,7 +159,8 @@ int main(int argc, char** argv) {
   try {
     const Options o = parse(argc, argv);
     jsa::set_threads(o.threads);
-    std::printf("bench_kernels: threads %d, median of %d runs after a warm-up\n", jsa::max_threads(), o.runs);
+    std::printf("bench_kernels: threads %d, median of %d runs after a warm-up\n",
+                jsa::max_threads(), o.runs);
     std::vector<std::pair<std::string, double>> ours;  // for ours.txt
 
     // ---- Chamfer, 6D and 2D ----
@@ -160,8 +169,10 @@ int main(int argc, char** argv) {
     const Block<float> x2 = uniform(o.points, 2, rng), y2 = uniform(o.points, 2, rng);
     const auto c6 = chamfer_kernel("chamfer6", x6, y6, o.runs);
     const auto c2 = chamfer_kernel("chamfer2", x2, y2, o.runs);
-    ours.insert(ours.end(), {{"chamfer6_value", c6.first}, {"chamfer6_s", c6.second},
-                             {"chamfer2_value", c2.first}, {"chamfer2_s", c2.second}});
+    ours.insert(ours.end(), {{"chamfer6_value", c6.first},
+                             {"chamfer6_s", c6.second},
+                             {"chamfer2_value", c2.first},
+                             {"chamfer2_s", c2.second}});
 
     // ---- repulsion: the cut-off against every pair ----
     {
@@ -173,13 +184,17 @@ int main(int argc, char** argv) {
       const double exact = jsa::repulsion_exact(mu, sigma, &g_exact);
       const double exact_s = seconds_since(t0);
       const double value_err = std::abs(cut - exact) / exact;
-      const double grad_err = double((g_cut - g_exact).cwiseAbs().maxCoeff() / g_exact.cwiseAbs().maxCoeff());
+      const double grad_err =
+          double((g_cut - g_exact).cwiseAbs().maxCoeff() / g_exact.cwiseAbs().maxCoeff());
       if (value_err > 1e-5 || grad_err > 1e-4)
         throw std::runtime_error("repulsion: the cut-off is off the exact sum");
       const double s = median_seconds(o.runs, [&]() { jsa::repulsion_cutoff(mu, sigma, &g_cut); });
-      std::printf("%-11s K = %-8d    L %.9g  vs exact (%.2f s): value %.1e, gradient %.1e relative  median %.4f s\n",
-                  "repulsion", o.gaussians, cut, exact_s, value_err, grad_err, s);
-      ours.insert(ours.end(), {{"repulsion_value", cut}, {"repulsion_error", value_err}, {"repulsion_s", s}});
+      std::printf(
+          "%-11s K = %-8d    L %.9g  vs exact (%.2f s): value %.1e, gradient %.1e relative  median "
+          "%.4f s\n",
+          "repulsion", o.gaussians, cut, exact_s, value_err, grad_err, s);
+      ours.insert(ours.end(),
+                  {{"repulsion_value", cut}, {"repulsion_error", value_err}, {"repulsion_s", s}});
     }
 
     // ---- exact assignment: LAPJV against the auction, then LAPJV timed ----
@@ -198,8 +213,9 @@ int main(int argc, char** argv) {
     const double assign_s = median_seconds(o.runs, [&]() { a = jsa::assign_lapjv(cost); });
     if (!jsa::check_certificate(cost, a).proves_optimal(1e-12))
       throw std::runtime_error("assignment: LAPJV's duals do not certify its matching");
-    std::printf("%-11s %6d x %-6d    cost %.12g  == auction (integer costs), certified  median %.4f s\n",
-                "assignment", o.n, o.n, a.cost, assign_s);
+    std::printf(
+        "%-11s %6d x %-6d    cost %.12g  == auction (integer costs), certified  median %.4f s\n",
+        "assignment", o.n, o.n, a.cost, assign_s);
     ours.insert(ours.end(), {{"assignment_cost", a.cost}, {"assignment_s", assign_s}});
 
     if (!o.dump.empty()) {

@@ -29,10 +29,10 @@
 
 namespace {
 
+using bench::Clock;
 using jsa::Block;
 using jsa::Index;
 using jsa::Var;
-using bench::Clock;
 
 const std::vector<int> kWidths = {2, 256, 256, 256, 256, 256, 3};
 
@@ -53,13 +53,18 @@ Options parse(int argc, char** argv) {
       if (i + 1 >= argc) throw std::runtime_error(a + " needs a value");
       char* end = nullptr;
       const long v = std::strtol(argv[++i], &end, 10);
-      if (*end != '\0' || v < 1) throw std::runtime_error(a + ": expected a positive integer, got '" + argv[i] + "'");
+      if (*end != '\0' || v < 1)
+        throw std::runtime_error(a + ": expected a positive integer, got '" + argv[i] + "'");
       return v;
     };
-    if (a == "--threads") o.threads = int(next());
-    else if (a == "--points") o.points = Index(next());
-    else if (a == "--runs") o.runs = int(next());
-    else throw std::runtime_error("unknown flag '" + a + "' (flags: --threads N --points N --runs N)");
+    if (a == "--threads")
+      o.threads = int(next());
+    else if (a == "--points")
+      o.points = Index(next());
+    else if (a == "--runs")
+      o.runs = int(next());
+    else
+      throw std::runtime_error("unknown flag '" + a + "' (flags: --threads N --points N --runs N)");
   }
   return o;
 }
@@ -112,8 +117,11 @@ float engine_step(jsa::Tape<float>& t, Phi& phi, const Block<float>& x, const Bl
   }
   const jsa::Stacked s = jsa::unstack(t, h);
   Var fit = jsa::mean(t, jsa::square(t, jsa::sub(t, s.value, t.constant(target))));
-  Var e = jsa::row_dot(t, s.du, s.du), f = jsa::row_dot(t, s.du, s.dv), g = jsa::row_dot(t, s.dv, s.dv);
-  Var iso = jsa::add(t, jsa::add(t, jsa::square(t, jsa::offset(t, e, -1.0f)), jsa::square(t, jsa::offset(t, g, -1.0f))),
+  Var e = jsa::row_dot(t, s.du, s.du), f = jsa::row_dot(t, s.du, s.dv),
+      g = jsa::row_dot(t, s.dv, s.dv);
+  Var iso = jsa::add(t,
+                     jsa::add(t, jsa::square(t, jsa::offset(t, e, -1.0f)),
+                              jsa::square(t, jsa::offset(t, g, -1.0f))),
                      jsa::scale(t, jsa::square(t, f), 2.0f));
   Var loss = jsa::add(t, fit, jsa::scale(t, jsa::mean(t, iso), 1e-3f));
   lap(local.loss);
@@ -198,9 +206,11 @@ int run(const Options& o) {
     const Block<float> plain = plain_forward(phi, x);
     const double err = (t.value(h).topRows(n) - plain).cwiseAbs().maxCoeff();
     const double scale = plain.cwiseAbs().maxCoeff();
-    std::printf("validate: max |engine - plain Eigen| = %.2e (values up to %.2e), loss %.5f, |grad| %.3e\n",
-                err, scale, double(loss),
-                double(Eigen::Map<const Eigen::VectorXf>(phi.p.grads().data(), Index(phi.p.size())).norm()));
+    std::printf(
+        "validate: max |engine - plain Eigen| = %.2e (values up to %.2e), loss %.5f, |grad| %.3e\n",
+        err, scale, double(loss),
+        double(
+            Eigen::Map<const Eigen::VectorXf>(phi.p.grads().data(), Index(phi.p.size())).norm()));
     if (!(err <= 1e-4 * std::max(1.0, scale)) || !std::isfinite(loss)) {
       std::fprintf(stderr, "validation failed\n");
       return 1;
@@ -231,18 +241,21 @@ int run(const Options& o) {
     return c;
   };
   const auto e_total = column(eng, [](const Phases& p) { return p.total(); });
-  const auto g_total = column(gem, [](const std::pair<double, double>& p) { return p.first + p.second; });
+  const auto g_total =
+      column(gem, [](const std::pair<double, double>& p) { return p.first + p.second; });
   const double te = median(e_total), tg = median(g_total);
   const double ge = flops / te * 1e-9, gg = flops / tg * 1e-9;
 
-  std::printf("\nphi 2-256x5-3, N = %ld points (%ld stacked rows), threads = %d, median of %d runs\n",
-              long(n), long(rows), jsa::max_threads(), o.runs);
-  std::printf("FLOPs per step: forward %.2f G, backward %.2f G, total %.2f G\n\n", fwd * 1e-9, bwd * 1e-9,
-              flops * 1e-9);
+  std::printf(
+      "\nphi 2-256x5-3, N = %ld points (%ld stacked rows), threads = %d, median of %d runs\n",
+      long(n), long(rows), jsa::max_threads(), o.runs);
+  std::printf("FLOPs per step: forward %.2f G, backward %.2f G, total %.2f G\n\n", fwd * 1e-9,
+              bwd * 1e-9, flops * 1e-9);
   std::printf("%-36s %10s %10s %10s %10s\n", "", "median ms", "min ms", "max ms", "GFLOP/s");
   auto line = [&](const char* name, const std::vector<double>& t, double f) {
     const double m = median(t);
-    std::printf("%-36s %10.1f %10.1f %10.1f", name, m * 1e3, *std::min_element(t.begin(), t.end()) * 1e3,
+    std::printf("%-36s %10.1f %10.1f %10.1f", name, m * 1e3,
+                *std::min_element(t.begin(), t.end()) * 1e3,
                 *std::max_element(t.begin(), t.end()) * 1e3);
     if (f > 0) std::printf(" %10.1f", f / m * 1e-9);
     std::printf("\n");
@@ -253,12 +266,13 @@ int run(const Options& o) {
   line("engine: forward total", column(eng, [](const Phases& p) { return p.forward(); }), fwd);
   line("engine: backward", column(eng, [](const Phases& p) { return p.backward; }), bwd);
   line("engine: step (fwd + loss + bwd)", e_total, flops);
-  line("Eigen SGEMM: forward", column(gem, [](const std::pair<double, double>& p) { return p.first; }), fwd);
-  line("Eigen SGEMM: backward (dW, dX)", column(gem, [](const std::pair<double, double>& p) { return p.second; }),
-       bwd);
+  line("Eigen SGEMM: forward",
+       column(gem, [](const std::pair<double, double>& p) { return p.first; }), fwd);
+  line("Eigen SGEMM: backward (dW, dX)",
+       column(gem, [](const std::pair<double, double>& p) { return p.second; }), bwd);
   line("Eigen SGEMM: step", g_total, flops);
-  std::printf("\nengine / GEMM throughput (step medians): %.1f%%  (target >= 60%%): %s\n", 100.0 * ge / gg,
-              ge >= 0.6 * gg ? "met" : "NOT met");
+  std::printf("\nengine / GEMM throughput (step medians): %.1f%%  (target >= 60%%): %s\n",
+              100.0 * ge / gg, ge >= 0.6 * gg ? "met" : "NOT met");
   std::printf("tape memory: %.1f MB\n", double(tape.bytes()) / (1 << 20));
   return 0;
 }

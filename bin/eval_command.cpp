@@ -2,7 +2,6 @@
 // Chamfer association), next to the sampling floor of the shape itself.
 #include <filesystem>
 #include <iostream>
-
 #include <nlohmann/json.hpp>
 
 #include "bin/commands.h"
@@ -27,11 +26,12 @@ void run_eval(const EvalArgs& a) {
   const CheckpointContents c = read_checkpoint(ckpt);
   auto atlas = load_atlas(c, ckpt);
   if (a.shape < 0 || a.shape >= int(c.inputs.size()))
-    throw InputError("--shape " + std::to_string(a.shape) + ": the run has " + std::to_string(c.inputs.size()) +
-                     " shape(s), numbered from 0");
+    throw InputError("--shape " + std::to_string(a.shape) + ": the run has " +
+                     std::to_string(c.inputs.size()) + " shape(s), numbered from 0");
   const std::string reference = a.reference.empty() ? c.inputs[size_t(a.shape)] : a.reference;
   const Mesh shape = load_shape(reference);
-  const Evaluation e = evaluate_reconstruction(*atlas, shape, c.normalizations[size_t(a.shape)], a.options, a.shape);
+  const Evaluation e =
+      evaluate_reconstruction(*atlas, shape, c.normalizations[size_t(a.shape)], a.options, a.shape);
   nlohmann::json j;
   j["run"] = a.run;
   j["reference"] = reference;
@@ -55,22 +55,30 @@ void run_eval(const EvalArgs& a) {
   j["emd_normal_alpha"] = 0.01 * e.fit_emd.normal;
   j["floor_chamfer_normal_alpha"] = 0.01 * e.floor.chamfer_normal;
   j["floor_emd_normal_alpha"] = 0.01 * e.floor_emd.normal;
-  const std::string json_path = a.run + (c.inputs.size() > 1 ? "/eval_" + std::to_string(a.shape) + ".json" : "/eval.json");
+  const std::string json_path =
+      a.run + (c.inputs.size() > 1 ? "/eval_" + std::to_string(a.shape) + ".json" : "/eval.json");
   write_file_atomically(json_path, [&](std::ostream& out) { out << j.dump(2) << "\n"; });
-  std::printf("reconstruction of %s (M' = %lld, x 1e-2, unit frame)\n", reference.c_str(), (long long)a.options.samples);
+  std::printf("reconstruction of %s (M' = %lld, x 1e-2, unit frame)\n", reference.c_str(),
+              (long long)a.options.samples);
   std::printf("                     atlas   floor   ratio\n");
   std::printf("  Chamfer spatial   %6.3f  %6.3f  %5.2f\n", 100 * e.fit.chamfer_spatial,
               100 * e.floor.chamfer_spatial, e.fit.chamfer_spatial / e.floor.chamfer_spatial);
-  std::printf("  Chamfer normal    %6.3f  %6.3f  %5.2f   (unit normals; Table 1 uses alpha = 0.01 x these)\n",
-              100 * e.fit.chamfer_normal, 100 * e.floor.chamfer_normal, e.fit.chamfer_normal / e.floor.chamfer_normal);
-  std::printf("  back-facing %%      %6.2f  %6.2f          (Chamfer pairs with n_p . n_q < 0)\n", 100 * e.fit.back_facing,
-              100 * e.floor.back_facing);
-  std::printf("  EMD spatial       %6.3f  %6.3f  %5.2f   (exact assignment, %.2f s)\n", 100 * e.fit_emd.spatial,
-              100 * e.floor_emd.spatial, e.fit_emd.spatial / e.floor_emd.spatial, e.fit_emd.seconds);
-  std::printf("  EMD normal        %6.3f  %6.3f  %5.2f\n", 100 * e.fit_emd.normal, 100 * e.floor_emd.normal,
-              e.fit_emd.normal / e.floor_emd.normal);
-  std::printf("  as Table 1 (normals of norm alpha = 0.01): normal Ch %.3f (floor %.3f), normal EMD %.3f (floor %.3f)\n",
-              e.fit.chamfer_normal, e.floor.chamfer_normal, e.fit_emd.normal, e.floor_emd.normal);
+  std::printf(
+      "  Chamfer normal    %6.3f  %6.3f  %5.2f   (unit normals; Table 1 uses alpha = 0.01 x "
+      "these)\n",
+      100 * e.fit.chamfer_normal, 100 * e.floor.chamfer_normal,
+      e.fit.chamfer_normal / e.floor.chamfer_normal);
+  std::printf("  back-facing %%      %6.2f  %6.2f          (Chamfer pairs with n_p . n_q < 0)\n",
+              100 * e.fit.back_facing, 100 * e.floor.back_facing);
+  std::printf("  EMD spatial       %6.3f  %6.3f  %5.2f   (exact assignment, %.2f s)\n",
+              100 * e.fit_emd.spatial, 100 * e.floor_emd.spatial,
+              e.fit_emd.spatial / e.floor_emd.spatial, e.fit_emd.seconds);
+  std::printf("  EMD normal        %6.3f  %6.3f  %5.2f\n", 100 * e.fit_emd.normal,
+              100 * e.floor_emd.normal, e.fit_emd.normal / e.floor_emd.normal);
+  std::printf(
+      "  as Table 1 (normals of norm alpha = 0.01): normal Ch %.3f (floor %.3f), normal EMD %.3f "
+      "(floor %.3f)\n",
+      e.fit.chamfer_normal, e.floor.chamfer_normal, e.fit_emd.normal, e.floor_emd.normal);
   std::printf("written: %s\n", json_path.c_str());
 }
 
@@ -78,13 +86,20 @@ void run_eval(const EvalArgs& a) {
 
 void add_eval(CLI::App& app) {
   auto a = std::make_shared<EvalArgs>();
-  CLI::App* c = app.add_subcommand("eval", "Reconstruction metrics of a fitted run (Table 1 Chamfer columns) and the sampling floor");
+  CLI::App* c = app.add_subcommand(
+      "eval",
+      "Reconstruction metrics of a fitted run (Table 1 Chamfer columns) and the sampling floor");
   c->add_option("run", a->run, "Run directory (holds model.ckpt)")->required();
   c->add_option("--reference", a->reference, "Ground-truth shape (default: the run's input)");
-  c->add_option("--samples", a->options.samples, "M': points on each side")->capture_default_str()->check(CLI::Range(Index(10), Index(1000000)));
+  c->add_option("--samples", a->options.samples, "M': points on each side")
+      ->capture_default_str()
+      ->check(CLI::Range(Index(10), Index(1000000)));
   c->add_option("--seed", a->options.seed, "Seed of the evaluation samples")->capture_default_str();
-  c->add_option("--threads", a->threads, "Threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
-  c->add_option("--shape", a->shape, "Which shape of a collection (0-based)")->capture_default_str();
+  c->add_option("--threads", a->threads, "Threads (0: all cores)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1024));
+  c->add_option("--shape", a->shape, "Which shape of a collection (0-based)")
+      ->capture_default_str();
   c->callback([a]() { run_eval(*a); });
 }
 

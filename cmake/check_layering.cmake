@@ -42,7 +42,7 @@ foreach(file ${files})
 endforeach()
 if(errors GREATER 0)
   message(FATAL_ERROR "layering: ${errors} include(s) break the rooms of cmake/rooms.cmake "
-                      "(docs/README.md, \"Rooms\")")
+                      "(docs/README.md, \"the rooms\")")
 endif()
 if(DEFINED STAMP)
   file(WRITE ${STAMP} "")  # creates the folder too

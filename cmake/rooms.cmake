@@ -1,10 +1,10 @@
-# The rooms of jsatlas and which rooms each one stands on (docs/README.md, "Rooms").
+# The rooms of jsatlas and which rooms each one stands on (docs/README.md, "the rooms").
 # One table, read by CMakeLists.txt (one static library per room, linked to the
 # rooms listed here) and by cmake/check_layering.cmake (an #include of a room
 # outside this list, direct or through the rooms it stands on, fails the build).
-# Only direct edges are listed; a room may use everything below them.
-#
-#   room         folder               stands on
+# jsatlas_room_dir_<room>: its folder (its own files only, not sub-folders);
+# jsatlas_room_uses_<room>: the rooms it stands on, direct edges only: a room may
+# use them and everything below them.
 set(jsatlas_rooms engine geometry io losses metrics model heuristics tool baselines pictures)
 set(jsatlas_room_dir_engine     engine)
 set(jsatlas_room_dir_geometry   io/geometry)

@@ -22,13 +22,16 @@ void Adam<T>::step(Parameters<T>& p, double lr) {
   const T* g = p.grads().data();
   T* m = m_.data();
   T* v = v_.data();
-  parallel_rows(Index(n), [&](Index i0, Index i1) {
-    for (Index i = i0; i < i1; ++i) {
-      m[i] = tb1 * m[i] + (T(1) - tb1) * g[i];
-      v[i] = tb2 * v[i] + (T(1) - tb2) * g[i] * g[i];
-      theta[i] -= a * (m[i] * c1) / (std::sqrt(v[i] * c2) + e);
-    }
-  }, 1 << 16);
+  parallel_rows(
+      Index(n),
+      [&](Index i0, Index i1) {
+        for (Index i = i0; i < i1; ++i) {
+          m[i] = tb1 * m[i] + (T(1) - tb1) * g[i];
+          v[i] = tb2 * v[i] + (T(1) - tb2) * g[i] * g[i];
+          theta[i] -= a * (m[i] * c1) / (std::sqrt(v[i] * c2) + e);
+        }
+      },
+      1 << 16);
 }
 
 double step_decay(double lr, int64_t iter, const std::vector<int64_t>& milestones, double factor) {

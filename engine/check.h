@@ -26,11 +26,11 @@ struct InputError : std::runtime_error {
 
 }  // namespace jsa
 
-#define JSA_CHECK(cond, msg)                                     \
-  do {                                                           \
-    if (!(cond)) {                                               \
-      std::ostringstream jsa_check_stream_;                      \
-      jsa_check_stream_ << #cond << " failed: " << msg;          \
+#define JSA_CHECK(cond, msg)                                          \
+  do {                                                                \
+    if (!(cond)) {                                                    \
+      std::ostringstream jsa_check_stream_;                           \
+      jsa_check_stream_ << #cond << " failed: " << msg;               \
       ::jsa::fail_check(__FILE__, __LINE__, jsa_check_stream_.str()); \
-    }                                                            \
+    }                                                                 \
   } while (0)

@@ -54,7 +54,9 @@ Dual<T, N> operator/(const Dual<T, N>& x, const Dual<T, N>& y) {
   return r;
 }
 template <class T, int N>
-Dual<T, N>& operator+=(Dual<T, N>& x, const Dual<T, N>& y) { return x = x + y; }
+Dual<T, N>& operator+=(Dual<T, N>& x, const Dual<T, N>& y) {
+  return x = x + y;
+}
 
 // sqrt(a + u ε) = sqrt(a) + u / (2 sqrt(a)) ε
 template <class T, int N>

@@ -70,7 +70,8 @@ GradCheckResult check_gradients(const GraphBuilder& f, std::vector<Block<double>
     }
   }
   result.ok = result.worst_ratio <= 1.0;
-  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) { return a.ratio > b.ratio; });
+  std::sort(entries.begin(), entries.end(),
+            [](const Entry& a, const Entry& b) { return a.ratio > b.ratio; });
   std::ostringstream s;
   s << "gradient check: " << result.checked << " entries, worst relative error "
     << result.worst_relative << ", worst error/tolerance " << result.worst_ratio << "\n";

@@ -19,48 +19,72 @@ namespace jsa {
 // Y = X W + b. X: N x Cin, W: Cin x Cout, b: 1 x Cout (or invalid Var for none).
 // bias_rows >= 0 adds b only to the first bias_rows rows: the stacked-tangent
 // convention, where rows past the value block are derivatives and carry no bias.
-template <class T> Var linear(Tape<T>& t, Var x, Var w, Var b, Index bias_rows = -1);
+template <class T>
+Var linear(Tape<T>& t, Var x, Var w, Var b, Index bias_rows = -1);
 // y = max(x, 0).
-template <class T> Var relu(Tape<T>& t, Var x);
+template <class T>
+Var relu(Tape<T>& t, Var x);
 // ReLU on stacked rows [value; tangent_1; ...], each block mask_rows tall: the
 // mask [value > 0] of the value block multiplies every block (chain rule for
 // d relu(z) = [z > 0] dz).
-template <class T> Var relu_masked(Tape<T>& t, Var x, Index mask_rows);
+template <class T>
+Var relu_masked(Tape<T>& t, Var x, Index mask_rows);
 // Softplus log(1 + e^(beta z)) / beta on stacked rows (block height m): the value
 // block z goes through it, each tangent block is multiplied by its derivative
 // sigmoid(beta z). A smooth ReLU (beta -> infinity gives ReLU back).
-template <class T> Var softplus_stacked(Tape<T>& t, Var x, Index m, T beta);
+template <class T>
+Var softplus_stacked(Tape<T>& t, Var x, Index m, T beta);
 
 // ---- elementwise (ops_elementwise.cpp) ----
 // b is either the shape of a, or 1 x C and then broadcast over a's rows,
 // or N x 1 and then broadcast over a's columns, or 1 x 1.
-template <class T> Var add(Tape<T>& t, Var a, Var b);
-template <class T> Var sub(Tape<T>& t, Var a, Var b);
-template <class T> Var mul(Tape<T>& t, Var a, Var b);
-template <class T> Var scale(Tape<T>& t, Var x, T c);   // c x
-template <class T> Var offset(Tape<T>& t, Var x, T c);  // x + c
-template <class T> Var square(Tape<T>& t, Var x);
+template <class T>
+Var add(Tape<T>& t, Var a, Var b);
+template <class T>
+Var sub(Tape<T>& t, Var a, Var b);
+template <class T>
+Var mul(Tape<T>& t, Var a, Var b);
+template <class T>
+Var scale(Tape<T>& t, Var x, T c);  // c x
+template <class T>
+Var offset(Tape<T>& t, Var x, T c);  // x + c
+template <class T>
+Var square(Tape<T>& t, Var x);
 // sqrt(x + eps): eps keeps the derivative 1/(2 sqrt(x + eps)) finite at x = 0.
-template <class T> Var sqrt(Tape<T>& t, Var x, T eps = T(1e-12));
-template <class T> Var exp(Tape<T>& t, Var x);
+template <class T>
+Var sqrt(Tape<T>& t, Var x, T eps = T(1e-12));
+template <class T>
+Var exp(Tape<T>& t, Var x);
 
 // ---- rows and columns (ops_rows.cpp) ----
-template <class T> Var concat_cols(Tape<T>& t, const std::vector<Var>& xs);
-template <class T> Var slice_cols(Tape<T>& t, Var x, Index begin, Index count);
-template <class T> Var concat_rows(Tape<T>& t, const std::vector<Var>& xs);
-template <class T> Var slice_rows(Tape<T>& t, Var x, Index begin, Index count);
+template <class T>
+Var concat_cols(Tape<T>& t, const std::vector<Var>& xs);
+template <class T>
+Var slice_cols(Tape<T>& t, Var x, Index begin, Index count);
+template <class T>
+Var concat_rows(Tape<T>& t, const std::vector<Var>& xs);
+template <class T>
+Var slice_rows(Tape<T>& t, Var x, Index begin, Index count);
 // y_i = x_{index_i}; the pull-back scatter-adds, serially, so it is deterministic.
-template <class T> Var gather_rows(Tape<T>& t, Var x, const std::vector<int>& index);
+template <class T>
+Var gather_rows(Tape<T>& t, Var x, const std::vector<int>& index);
 
 // ---- reductions and per-row geometry (ops_reduce.cpp) ----
-template <class T> Var sum(Tape<T>& t, Var x);   // 1 x 1
-template <class T> Var mean(Tape<T>& t, Var x);  // 1 x 1
-template <class T> Var row_sum(Tape<T>& t, Var x);          // N x 1
-template <class T> Var row_dot(Tape<T>& t, Var a, Var b);   // N x 1: <a_i, b_i>
+template <class T>
+Var sum(Tape<T>& t, Var x);  // 1 x 1
+template <class T>
+Var mean(Tape<T>& t, Var x);  // 1 x 1
+template <class T>
+Var row_sum(Tape<T>& t, Var x);  // N x 1
+template <class T>
+Var row_dot(Tape<T>& t, Var a, Var b);  // N x 1: <a_i, b_i>
 // sqrt(|x_i|^2 + eps), N x 1 (eps as in sqrt above).
-template <class T> Var row_norm(Tape<T>& t, Var x, T eps = T(1e-12));
+template <class T>
+Var row_norm(Tape<T>& t, Var x, T eps = T(1e-12));
 // x_i / sqrt(|x_i|^2 + eps), N x C.
-template <class T> Var row_normalize(Tape<T>& t, Var x, T eps = T(1e-12));
-template <class T> Var cross3(Tape<T>& t, Var a, Var b);    // N x 3: a_i x b_i
+template <class T>
+Var row_normalize(Tape<T>& t, Var x, T eps = T(1e-12));
+template <class T>
+Var cross3(Tape<T>& t, Var a, Var b);  // N x 3: a_i x b_i
 
 }  // namespace jsa

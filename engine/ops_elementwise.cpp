@@ -26,10 +26,14 @@ Shape broadcast_shape(const Tape<T>& t, Var a, Var b, const char* op) {
 template <class T>
 Block<T> expand(const Block<T>& b, Index n, Index c, Shape s) {
   switch (s) {
-    case Shape::Same: return b;
-    case Shape::Row: return b.replicate(n, 1);
-    case Shape::Col: return b.replicate(1, c);
-    case Shape::Scalar: return Block<T>::Constant(n, c, b(0, 0));
+    case Shape::Same:
+      return b;
+    case Shape::Row:
+      return b.replicate(n, 1);
+    case Shape::Col:
+      return b.replicate(1, c);
+    case Shape::Scalar:
+      return Block<T>::Constant(n, c, b(0, 0));
   }
   return b;
 }
@@ -38,10 +42,18 @@ Block<T> expand(const Block<T>& b, Index n, Index c, Shape s) {
 template <class T>
 void reduce_into(Block<T>& db, const Block<T>& g, Shape s) {
   switch (s) {
-    case Shape::Same: db += g; break;
-    case Shape::Row: db += g.colwise().sum(); break;
-    case Shape::Col: db += g.rowwise().sum(); break;
-    case Shape::Scalar: db(0, 0) += g.sum(); break;
+    case Shape::Same:
+      db += g;
+      break;
+    case Shape::Row:
+      db += g.colwise().sum();
+      break;
+    case Shape::Col:
+      db += g.rowwise().sum();
+      break;
+    case Shape::Scalar:
+      db(0, 0) += g.sum();
+      break;
   }
 }
 
@@ -52,8 +64,10 @@ template <class T>
 Var add(Tape<T>& t, Var a, Var b) {
   const Shape s = broadcast_shape(t, a, b, "add");
   Var y = t.node(t.rows(a), t.cols(a), {a, b});
-  if (s == Shape::Same) t.value(y) = t.value(a) + t.value(b);
-  else t.value(y) = t.value(a) + expand(t.value(b), t.rows(a), t.cols(a), s);
+  if (s == Shape::Same)
+    t.value(y) = t.value(a) + t.value(b);
+  else
+    t.value(y) = t.value(a) + expand(t.value(b), t.rows(a), t.cols(a), s);
   t.on_backward(y, [a, b, s](Tape<T>& t, Var y) {
     if (t.needs_grad(a)) t.grad(a) += t.grad(y);
     if (t.needs_grad(b)) reduce_into(t.grad(b), t.grad(y), s);
@@ -66,8 +80,10 @@ template <class T>
 Var sub(Tape<T>& t, Var a, Var b) {
   const Shape s = broadcast_shape(t, a, b, "sub");
   Var y = t.node(t.rows(a), t.cols(a), {a, b});
-  if (s == Shape::Same) t.value(y) = t.value(a) - t.value(b);
-  else t.value(y) = t.value(a) - expand(t.value(b), t.rows(a), t.cols(a), s);
+  if (s == Shape::Same)
+    t.value(y) = t.value(a) - t.value(b);
+  else
+    t.value(y) = t.value(a) - expand(t.value(b), t.rows(a), t.cols(a), s);
   t.on_backward(y, [a, b, s](Tape<T>& t, Var y) {
     if (t.needs_grad(a)) t.grad(a) += t.grad(y);
     if (t.needs_grad(b)) {
@@ -84,13 +100,17 @@ Var mul(Tape<T>& t, Var a, Var b) {
   const Shape s = broadcast_shape(t, a, b, "mul");
   Var y = t.node(t.rows(a), t.cols(a), {a, b});
   const Index n = t.rows(a), c = t.cols(a);
-  if (s == Shape::Same) t.value(y) = t.value(a).cwiseProduct(t.value(b));
-  else t.value(y) = t.value(a).cwiseProduct(expand(t.value(b), n, c, s));
+  if (s == Shape::Same)
+    t.value(y) = t.value(a).cwiseProduct(t.value(b));
+  else
+    t.value(y) = t.value(a).cwiseProduct(expand(t.value(b), n, c, s));
   t.on_backward(y, [a, b, s, n, c](Tape<T>& t, Var y) {
     const Block<T>& dY = t.grad(y);
     if (t.needs_grad(a)) {
-      if (s == Shape::Same) t.grad(a) += dY.cwiseProduct(t.value(b));
-      else t.grad(a) += dY.cwiseProduct(expand(t.value(b), n, c, s));
+      if (s == Shape::Same)
+        t.grad(a) += dY.cwiseProduct(t.value(b));
+      else
+        t.grad(a) += dY.cwiseProduct(expand(t.value(b), n, c, s));
     }
     if (t.needs_grad(b)) {
       Block<T> g = dY.cwiseProduct(t.value(a));
@@ -145,20 +165,19 @@ template <class T>
 Var exp(Tape<T>& t, Var x) {
   Var y = t.node(t.rows(x), t.cols(x), {x});
   t.value(y) = t.value(x).array().exp();
-  t.on_backward(y, [x](Tape<T>& t, Var y) {
-    t.grad(x).array() += t.value(y).array() * t.grad(y).array();
-  });
+  t.on_backward(
+      y, [x](Tape<T>& t, Var y) { t.grad(x).array() += t.value(y).array() * t.grad(y).array(); });
   return y;
 }
 
-#define JSA_INSTANTIATE(T)                           \
-  template Var add<T>(Tape<T>&, Var, Var);           \
-  template Var sub<T>(Tape<T>&, Var, Var);           \
-  template Var mul<T>(Tape<T>&, Var, Var);           \
-  template Var scale<T>(Tape<T>&, Var, T);           \
-  template Var offset<T>(Tape<T>&, Var, T);          \
-  template Var square<T>(Tape<T>&, Var);             \
-  template Var sqrt<T>(Tape<T>&, Var, T);            \
+#define JSA_INSTANTIATE(T)                  \
+  template Var add<T>(Tape<T>&, Var, Var);  \
+  template Var sub<T>(Tape<T>&, Var, Var);  \
+  template Var mul<T>(Tape<T>&, Var, Var);  \
+  template Var scale<T>(Tape<T>&, Var, T);  \
+  template Var offset<T>(Tape<T>&, Var, T); \
+  template Var square<T>(Tape<T>&, Var);    \
+  template Var sqrt<T>(Tape<T>&, Var, T);   \
   template Var exp<T>(Tape<T>&, Var);
 JSA_INSTANTIATE(float)
 JSA_INSTANTIATE(double)

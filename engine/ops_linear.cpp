@@ -11,7 +11,8 @@ namespace jsa {
 template <class T>
 Var linear(Tape<T>& t, Var x, Var w, Var b, Index bias_rows) {
   const Index n = t.rows(x), cin = t.cols(x), cout = t.cols(w);
-  JSA_CHECK(t.rows(w) == cin, "linear: X is " << n << "x" << cin << ", W is " << t.rows(w) << "x" << cout);
+  JSA_CHECK(t.rows(w) == cin,
+            "linear: X is " << n << "x" << cin << ", W is " << t.rows(w) << "x" << cout);
   if (bias_rows < 0) bias_rows = n;
   JSA_CHECK(bias_rows <= n, "linear: bias on " << bias_rows << " rows of " << n);
   Var y = b.valid() ? t.node(n, cout, {x, w, b}) : t.node(n, cout, {x, w});
@@ -20,7 +21,8 @@ Var linear(Tape<T>& t, Var x, Var w, Var b, Index bias_rows) {
   if (b.valid()) {
     JSA_CHECK(t.rows(b) == 1 && t.cols(b) == cout, "linear: bias must be 1x" << cout);
     const auto bias = t.value(b).row(0);
-    parallel_rows(bias_rows, [&](Index r0, Index r1) { Y.middleRows(r0, r1 - r0).rowwise() += bias; });
+    parallel_rows(bias_rows,
+                  [&](Index r0, Index r1) { Y.middleRows(r0, r1 - r0).rowwise() += bias; });
   }
   // dX += dY W^T ;  dW += X^T dY ;  db += sum over the biased rows of dY
   t.on_backward(y, [x, w, b, bias_rows](Tape<T>& t, Var y) {
@@ -55,9 +57,8 @@ Var relu_masked(Tape<T>& t, Var x, Index m) {
   const Index blocks = n / m;
   parallel_rows(m, [&](Index r0, Index r1) {
     for (Index k = 0; k < blocks; ++k)
-      Y.middleRows(k * m + r0, r1 - r0) =
-          (X.middleRows(r0, r1 - r0).array() > T(0))
-              .select(X.middleRows(k * m + r0, r1 - r0), T(0));
+      Y.middleRows(k * m + r0, r1 - r0) = (X.middleRows(r0, r1 - r0).array() > T(0))
+                                              .select(X.middleRows(k * m + r0, r1 - r0), T(0));
   });
   // dx_k += [z > 0] * dy_k   (the mask itself is piecewise constant: no gradient)
   t.on_backward(y, [x, m, blocks](Tape<T>& t, Var y) {
@@ -66,9 +67,8 @@ Var relu_masked(Tape<T>& t, Var x, Index m) {
     Block<T>& dX = t.grad(x);
     parallel_rows(m, [&](Index r0, Index r1) {
       for (Index k = 0; k < blocks; ++k)
-        dX.middleRows(k * m + r0, r1 - r0) +=
-            (X.middleRows(r0, r1 - r0).array() > T(0))
-                .select(dY.middleRows(k * m + r0, r1 - r0), T(0));
+        dX.middleRows(k * m + r0, r1 - r0) += (X.middleRows(r0, r1 - r0).array() > T(0))
+                                                  .select(dY.middleRows(k * m + r0, r1 - r0), T(0));
     });
   });
   return y;
@@ -113,9 +113,11 @@ Var softplus_stacked(Tape<T>& t, Var x, Index m, T beta) {
       const Eigen::Array<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> e = (-bz.abs()).exp();
       const Eigen::Array<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> s1 =
           (bz >= T(0)).select(T(1) / (T(1) + e), e / (T(1) + e));
-      Eigen::Array<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> dz = dY.middleRows(r0, h).array() * s1;
+      Eigen::Array<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> dz =
+          dY.middleRows(r0, h).array() * s1;
       if (blocks > 1) {
-        const Eigen::Array<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> s2 = beta * s1 * (T(1) - s1);
+        const Eigen::Array<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> s2 =
+            beta * s1 * (T(1) - s1);
         for (Index k = 1; k < blocks; ++k) {
           dz += dY.middleRows(k * m + r0, h).array() * X.middleRows(k * m + r0, h).array() * s2;
           dX.middleRows(k * m + r0, h).array() += dY.middleRows(k * m + r0, h).array() * s1;
@@ -127,10 +129,10 @@ Var softplus_stacked(Tape<T>& t, Var x, Index m, T beta) {
   return y;
 }
 
-#define JSA_INSTANTIATE(T)                                    \
-  template Var linear<T>(Tape<T>&, Var, Var, Var, Index);     \
-  template Var relu<T>(Tape<T>&, Var);                        \
-  template Var relu_masked<T>(Tape<T>&, Var, Index);          \
+#define JSA_INSTANTIATE(T)                                \
+  template Var linear<T>(Tape<T>&, Var, Var, Var, Index); \
+  template Var relu<T>(Tape<T>&, Var);                    \
+  template Var relu_masked<T>(Tape<T>&, Var, Index);      \
   template Var softplus_stacked<T>(Tape<T>&, Var, Index, T);
 JSA_INSTANTIATE(float)
 JSA_INSTANTIATE(double)

@@ -29,9 +29,7 @@ template <class T>
 Var row_sum(Tape<T>& t, Var x) {
   Var y = t.node(t.rows(x), 1, {x});
   t.value(y) = t.value(x).rowwise().sum();
-  t.on_backward(y, [x](Tape<T>& t, Var y) {
-    t.grad(x).colwise() += t.grad(y).col(0);
-  });
+  t.on_backward(y, [x](Tape<T>& t, Var y) { t.grad(x).colwise() += t.grad(y).col(0); });
   return y;
 }
 
@@ -69,7 +67,8 @@ Var row_normalize(Tape<T>& t, Var x, T eps) {
   Var y = t.node(t.rows(x), t.cols(x), {x});
   const Block<T>& X = t.value(x);
   Block<T>& Y = t.value(y);
-  for (Index i = 0; i < X.rows(); ++i) Y.row(i) = X.row(i) / std::sqrt(X.row(i).squaredNorm() + eps);
+  for (Index i = 0; i < X.rows(); ++i)
+    Y.row(i) = X.row(i) / std::sqrt(X.row(i).squaredNorm() + eps);
   t.on_backward(y, [x, eps](Tape<T>& t, Var y) {
     const Block<T>& X = t.value(x);
     const Block<T>& Y = t.value(y);
@@ -119,13 +118,13 @@ Var cross3(Tape<T>& t, Var a, Var b) {
   return y;
 }
 
-#define JSA_INSTANTIATE(T)                          \
-  template Var sum<T>(Tape<T>&, Var);               \
-  template Var mean<T>(Tape<T>&, Var);              \
-  template Var row_sum<T>(Tape<T>&, Var);           \
-  template Var row_dot<T>(Tape<T>&, Var, Var);      \
-  template Var row_norm<T>(Tape<T>&, Var, T);       \
-  template Var row_normalize<T>(Tape<T>&, Var, T);  \
+#define JSA_INSTANTIATE(T)                         \
+  template Var sum<T>(Tape<T>&, Var);              \
+  template Var mean<T>(Tape<T>&, Var);             \
+  template Var row_sum<T>(Tape<T>&, Var);          \
+  template Var row_dot<T>(Tape<T>&, Var, Var);     \
+  template Var row_norm<T>(Tape<T>&, Var, T);      \
+  template Var row_normalize<T>(Tape<T>&, Var, T); \
   template Var cross3<T>(Tape<T>&, Var, Var);
 JSA_INSTANTIATE(float)
 JSA_INSTANTIATE(double)

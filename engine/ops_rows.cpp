@@ -31,9 +31,8 @@ Var slice_cols(Tape<T>& t, Var x, Index begin, Index count) {
             "slice_cols [" << begin << ", " << begin + count << ") of " << t.cols(x));
   Var y = t.node(t.rows(x), count, {x});
   t.value(y) = t.value(x).middleCols(begin, count);
-  t.on_backward(y, [x, begin, count](Tape<T>& t, Var y) {
-    t.grad(x).middleCols(begin, count) += t.grad(y);
-  });
+  t.on_backward(
+      y, [x, begin, count](Tape<T>& t, Var y) { t.grad(x).middleCols(begin, count) += t.grad(y); });
   return y;
 }
 
@@ -64,9 +63,8 @@ Var slice_rows(Tape<T>& t, Var x, Index begin, Index count) {
             "slice_rows [" << begin << ", " << begin + count << ") of " << t.rows(x));
   Var y = t.node(count, t.cols(x), {x});
   t.value(y) = t.value(x).middleRows(begin, count);
-  t.on_backward(y, [x, begin, count](Tape<T>& t, Var y) {
-    t.grad(x).middleRows(begin, count) += t.grad(y);
-  });
+  t.on_backward(
+      y, [x, begin, count](Tape<T>& t, Var y) { t.grad(x).middleRows(begin, count) += t.grad(y); });
   return y;
 }
 
@@ -78,7 +76,8 @@ Var gather_rows(Tape<T>& t, Var x, const std::vector<int>& index) {
   const Block<T>& X = t.value(x);
   Block<T>& Y = t.value(y);
   for (Index i = 0; i < n; ++i) {
-    JSA_CHECK(index[i] >= 0 && index[i] < rows, "gather_rows: index " << index[i] << " of " << rows);
+    JSA_CHECK(index[i] >= 0 && index[i] < rows,
+              "gather_rows: index " << index[i] << " of " << rows);
     Y.row(i) = X.row(index[i]);
   }
   if (!t.needs_grad(y)) return y;
@@ -92,11 +91,11 @@ Var gather_rows(Tape<T>& t, Var x, const std::vector<int>& index) {
   return y;
 }
 
-#define JSA_INSTANTIATE(T)                                             \
-  template Var concat_cols<T>(Tape<T>&, const std::vector<Var>&);      \
-  template Var slice_cols<T>(Tape<T>&, Var, Index, Index);             \
-  template Var concat_rows<T>(Tape<T>&, const std::vector<Var>&);      \
-  template Var slice_rows<T>(Tape<T>&, Var, Index, Index);             \
+#define JSA_INSTANTIATE(T)                                        \
+  template Var concat_cols<T>(Tape<T>&, const std::vector<Var>&); \
+  template Var slice_cols<T>(Tape<T>&, Var, Index, Index);        \
+  template Var concat_rows<T>(Tape<T>&, const std::vector<Var>&); \
+  template Var slice_rows<T>(Tape<T>&, Var, Index, Index);        \
   template Var gather_rows<T>(Tape<T>&, Var, const std::vector<int>&);
 JSA_INSTANTIATE(float)
 JSA_INSTANTIATE(double)

@@ -40,7 +40,9 @@ Var Parameters<T>::on(Tape<T>& t, int i) {
 // rows*cols values of T (little-endian host order; checkpoints add a checksum).
 template <class T>
 void Parameters<T>::save(std::ostream& out) const {
-  auto put = [&](const void* p, size_t n) { out.write(static_cast<const char*>(p), std::streamsize(n)); };
+  auto put = [&](const void* p, size_t n) {
+    out.write(static_cast<const char*>(p), std::streamsize(n));
+  };
   const uint32_t count = uint32_t(entries_.size());
   put(&count, sizeof count);
   for (const Entry& e : entries_) {
@@ -78,7 +80,8 @@ void Parameters<T>::load(std::istream& in, const std::string& what) {
     get(&c, sizeof c);
     const int i = find(name);
     if (i < 0) throw InputError(what + ": unknown parameter '" + name + "'");
-    if (seen[i]) throw InputError(what + ": parameter '" + name + "' appears twice (corrupt file?)");
+    if (seen[i])
+      throw InputError(what + ": parameter '" + name + "' appears twice (corrupt file?)");
     seen[i] = true;
     if (r != entries_[i].rows || c != entries_[i].cols)
       throw InputError(what + ": parameter '" + name + "' is " + std::to_string(r) + "x" +

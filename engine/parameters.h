@@ -28,11 +28,15 @@ class Parameters {
   const Entry& entry(int i) const { return entries_[i]; }
   size_t size() const { return value_.size(); }
 
-  Map value(int i) { return Map(value_.data() + entries_[i].offset, entries_[i].rows, entries_[i].cols); }
+  Map value(int i) {
+    return Map(value_.data() + entries_[i].offset, entries_[i].rows, entries_[i].cols);
+  }
   ConstMap value(int i) const {
     return ConstMap(value_.data() + entries_[i].offset, entries_[i].rows, entries_[i].cols);
   }
-  Map grad(int i) { return Map(grad_.data() + entries_[i].offset, entries_[i].rows, entries_[i].cols); }
+  Map grad(int i) {
+    return Map(grad_.data() + entries_[i].offset, entries_[i].rows, entries_[i].cols);
+  }
   std::vector<T>& values() { return value_; }
   const std::vector<T>& values() const { return value_; }
   std::vector<T>& grads() { return grad_; }

@@ -18,12 +18,14 @@
 namespace jsa {
 
 // [x; e_u; e_v] (3N x D), tangent rows constant (one-hot in column 0 or 1).
-template <class T> Var stack_tangents(Tape<T>& t, Var x);
+template <class T>
+Var stack_tangents(Tape<T>& t, Var x);
 
 // The three N-row blocks of a stacked output.
 struct Stacked {
   Var value, du, dv;
 };
-template <class T> Stacked unstack(Tape<T>& t, Var y);
+template <class T>
+Stacked unstack(Tape<T>& t, Var y);
 
 }  // namespace jsa

@@ -105,8 +105,7 @@ class Tape {
   // Bytes held by node values and gradients (for memory reports).
   size_t bytes() const {
     size_t b = 0;
-    for (const Node& n : nodes_)
-      b += sizeof(T) * size_t(n.value.size() + n.grad.size());
+    for (const Node& n : nodes_) b += sizeof(T) * size_t(n.value.size() + n.grad.size());
     return b;
   }
 

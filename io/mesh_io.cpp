@@ -49,7 +49,8 @@ void write_obj(const std::string& path, const Mesh& mesh, const Block<double>* u
       out << "v " << mesh.vertices(v, 0) << " " << mesh.vertices(v, 1) << " " << mesh.vertices(v, 2)
           << "\n";
     if (uv)
-      for (Index v = 0; v < uv->rows(); ++v) out << "vt " << (*uv)(v, 0) << " " << (*uv)(v, 1) << "\n";
+      for (Index v = 0; v < uv->rows(); ++v)
+        out << "vt " << (*uv)(v, 0) << " " << (*uv)(v, 1) << "\n";
     if (mesh.has_normals())
       for (Index v = 0; v < count; ++v)
         out << "vn " << mesh.normals(v, 0) << " " << mesh.normals(v, 1) << " " << mesh.normals(v, 2)

@@ -7,8 +7,8 @@
 #include <numeric>
 #include <utility>
 
-#include "io/input_file.h"
 #include "io/geometry/vertex_normals.h"
+#include "io/input_file.h"
 
 namespace jsa {
 namespace {

@@ -35,7 +35,8 @@ double match_both_ways(const Block<T>& x, const Block<T>& y, const NearestIndex<
 // The own-row terms write disjoint rows (parallel); the scatter-adds run serially
 // in index order, so the sums are the same for every thread count.
 template <class T>
-Var chamfer_op(Tape<T>& t, Var x, Var y, const NearestIndex<T>* surface, ChamferMatches<T>* matches) {
+Var chamfer_op(Tape<T>& t, Var x, Var y, const NearestIndex<T>* surface,
+               ChamferMatches<T>* matches) {
   ChamferMatches<T> local;
   ChamferMatches<T>& m = matches ? *matches : local;
   const double value = match_both_ways(t.value(x), t.value(y), surface, m);
@@ -76,7 +77,8 @@ Var chamfer_op(Tape<T>& t, Var x, Var y, const NearestIndex<T>* surface, Chamfer
 template <class T>
 double chamfer_distance(const Block<T>& x, const Block<T>& y, ChamferMatches<T>* matches) {
   ChamferMatches<T> local;
-  return match_both_ways(x, y, static_cast<const NearestIndex<T>*>(nullptr), matches ? *matches : local);
+  return match_both_ways(x, y, static_cast<const NearestIndex<T>*>(nullptr),
+                         matches ? *matches : local);
 }
 
 template <class T>
@@ -89,9 +91,9 @@ Var chamfer(Tape<T>& t, Var x, Var y, const NearestIndex<T>& surface, ChamferMat
   return chamfer_op(t, x, y, &surface, matches);
 }
 
-#define JSA_INSTANTIATE(T)                                         \
-  template struct ChamferMatches<T>;                               \
-  template Var chamfer<T>(Tape<T>&, Var, Var, ChamferMatches<T>*); \
+#define JSA_INSTANTIATE(T)                                                                 \
+  template struct ChamferMatches<T>;                                                       \
+  template Var chamfer<T>(Tape<T>&, Var, Var, ChamferMatches<T>*);                         \
   template Var chamfer<T>(Tape<T>&, Var, Var, const NearestIndex<T>&, ChamferMatches<T>*); \
   template double chamfer_distance<T>(const Block<T>&, const Block<T>&, ChamferMatches<T>*);
 JSA_INSTANTIATE(float)

@@ -44,7 +44,8 @@ Var chamfer(Tape<T>& t, Var x, Var y, ChamferMatches<T>* matches = nullptr);
 // it is the one that asks for coverage. The pool is a constant (no gradient);
 // matches->x_to_y then indexes surface.points().
 template <class T>
-Var chamfer(Tape<T>& t, Var x, Var y, const NearestIndex<T>& surface, ChamferMatches<T>* matches = nullptr);
+Var chamfer(Tape<T>& t, Var x, Var y, const NearestIndex<T>& surface,
+            ChamferMatches<T>* matches = nullptr);
 
 // The same value without a tape (evaluation). Sums accumulate in double.
 template <class T>

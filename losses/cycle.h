@@ -7,6 +7,7 @@
 namespace jsa {
 
 // (1/M) sum_m |a_m - b_m|^2 for two M x C blocks.
-template <class T> Var mean_squared_distance(Tape<T>& t, Var a, Var b);
+template <class T>
+Var mean_squared_distance(Tape<T>& t, Var a, Var b);
 
 }  // namespace jsa

@@ -9,6 +9,7 @@
 
 namespace jsa {
 
-template <class T> Var isometry_loss(Tape<T>& t, Var du, Var dv);
+template <class T>
+Var isometry_loss(Tape<T>& t, Var du, Var dv);
 
 }  // namespace jsa

@@ -11,8 +11,11 @@ Atlas<T>::Atlas(const AtlasOptions& o) : options_(o) {
   JSA_CHECK(o.shapes >= 1 && (o.shapes == 1 || o.code_size > 0), "bad collection size");
   const int d = o.shapes > 1 ? o.code_size : 0;
   domain = Domain<T>(params, DomainOptions{o.gaussians, o.gaussian_noise});
-  phi = Parametrization<T>(params, MlpShape{2, 3, o.width, o.hidden_layers, d, o.code_layer, o.softplus_beta}, T(o.alpha));
-  psi = Chart<T>(params, MlpShape{6, 2, o.width, o.hidden_layers, d, o.code_layer, o.softplus_beta});
+  phi = Parametrization<T>(
+      params, MlpShape{2, 3, o.width, o.hidden_layers, d, o.code_layer, o.softplus_beta},
+      T(o.alpha));
+  psi =
+      Chart<T>(params, MlpShape{6, 2, o.width, o.hidden_layers, d, o.code_layer, o.softplus_beta});
   if (d > 0) {
     phi_codes_ = params.add("codes.phi", o.shapes, d);
     psi_codes_ = params.add("codes.psi", o.shapes, d);

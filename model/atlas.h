@@ -11,15 +11,17 @@
 namespace jsa {
 
 struct AtlasOptions {
-  int gaussians = 10000;    // K, the number of Gaussians in P (paper: 10^4)
-  int width = 256;          // hidden units of phi and psi (paper: 256)
-  int hidden_layers = 5;    // hidden layers of phi and psi (paper: 5)
-  double alpha = 0.01;      // norm of the normals fed to psi and produced by phi6 (paper: 0.01)
+  int gaussians = 10000;       // K, the number of Gaussians in P (paper: 10^4)
+  int width = 256;             // hidden units of phi and psi (paper: 256)
+  int hidden_layers = 5;       // hidden layers of phi and psi (paper: 5)
+  double alpha = 0.01;         // norm of the normals fed to psi and produced by phi6 (paper: 0.01)
   bool gaussian_noise = true;  // sample P (true) or the means alone (Table 1 rows 6-8)
-  int shapes = 1;           // N shapes sharing the domain (Sec. 3.4); > 1 adds latent codes
-  int code_size = 256;      // D, width of f_phi,i and f_psi,i when shapes > 1 (paper: 256)
-  int code_layer = 0;       // where codes enter phi and psi: 0 the input (concatenation), 1 after the first layer
-  double softplus_beta = 0;  // activation of phi and psi: 0 ReLU (paper), > 0 softplus of that sharpness
+  int shapes = 1;              // N shapes sharing the domain (Sec. 3.4); > 1 adds latent codes
+  int code_size = 256;         // D, width of f_phi,i and f_psi,i when shapes > 1 (paper: 256)
+  int code_layer =
+      0;  // where codes enter phi and psi: 0 the input (concatenation), 1 after the first layer
+  double softplus_beta =
+      0;  // activation of phi and psi: 0 ReLU (paper), > 0 softplus of that sharpness
 };
 
 template <class T>

@@ -59,24 +59,29 @@ std::vector<double> Domain<T>::density(const Parameters<T>& params, const Block<
   for (Index k = 0; k < mu.rows(); ++k)
     cell[size_t(cell_of(mu(k, 0), 0, gx)) * gy + cell_of(mu(k, 1), 1, gy)].push_back(int(k));
   std::vector<double> p(size_t(x.rows()), 0.0);
-  parallel_rows(x.rows(), [&](Index r0, Index r1) {
-    for (Index r = r0; r < r1; ++r) {
-      const double qx = x(r, 0), qy = x(r, 1);
-      if (qx < lo[0] - window || qx > hi[0] + window || qy < lo[1] - window || qy > hi[1] + window)
-        continue;
-      const int cx = int(std::floor((qx - lo[0]) / window)), cy = int(std::floor((qy - lo[1]) / window));
-      double acc = 0;
-      for (int i = cx - 1; i <= cx + 1; ++i)
-        for (int j = cy - 1; j <= cy + 1; ++j) {
-          if (i < 0 || j < 0 || i >= gx || j >= gy) continue;
-          for (int k : cell[size_t(i) * gy + j]) {
-            const double dx = qx - mu(k, 0), dy = qy - mu(k, 1);
-            acc += std::exp(-(dx * dx + dy * dy) * inv2s2);
-          }
+  parallel_rows(
+      x.rows(),
+      [&](Index r0, Index r1) {
+        for (Index r = r0; r < r1; ++r) {
+          const double qx = x(r, 0), qy = x(r, 1);
+          if (qx < lo[0] - window || qx > hi[0] + window || qy < lo[1] - window ||
+              qy > hi[1] + window)
+            continue;
+          const int cx = int(std::floor((qx - lo[0]) / window)),
+                    cy = int(std::floor((qy - lo[1]) / window));
+          double acc = 0;
+          for (int i = cx - 1; i <= cx + 1; ++i)
+            for (int j = cy - 1; j <= cy + 1; ++j) {
+              if (i < 0 || j < 0 || i >= gx || j >= gy) continue;
+              for (int k : cell[size_t(i) * gy + j]) {
+                const double dx = qx - mu(k, 0), dy = qy - mu(k, 1);
+                acc += std::exp(-(dx * dx + dy * dy) * inv2s2);
+              }
+            }
+          p[size_t(r)] = acc * norm;
         }
-      p[size_t(r)] = acc * norm;
-    }
-  }, 256);
+      },
+      256);
   return p;
 }
 

@@ -15,7 +15,7 @@
 namespace jsa {
 
 struct DomainOptions {
-  int gaussians = 10000;   // K (paper: 10^4)
+  int gaussians = 10000;       // K (paper: 10^4)
   bool gaussian_noise = true;  // false: sample the means themselves (Table 1, row 6-8)
 };
 

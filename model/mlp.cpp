@@ -8,7 +8,8 @@ namespace jsa {
 
 template <class T>
 Mlp<T>::Mlp(Parameters<T>& params, const std::string& name, const MlpShape& shape) : shape_(shape) {
-  JSA_CHECK(shape.in > 0 && shape.out > 0 && shape.width > 0 && shape.hidden_layers >= 0, "bad MLP shape");
+  JSA_CHECK(shape.in > 0 && shape.out > 0 && shape.width > 0 && shape.hidden_layers >= 0,
+            "bad MLP shape");
   int in = shape.in;
   for (int k = 0; k <= shape.hidden_layers; ++k) {
     const int out = k == shape.hidden_layers ? shape.out : shape.width;
@@ -16,7 +17,8 @@ Mlp<T>::Mlp(Parameters<T>& params, const std::string& name, const MlpShape& shap
     bias_.push_back(params.add(name + ".b" + std::to_string(k), 1, out));
     in = out;
   }
-  JSA_CHECK(shape.softplus_beta >= 0, "softplus beta must be >= 0 (0: ReLU), got " << shape.softplus_beta);
+  JSA_CHECK(shape.softplus_beta >= 0,
+            "softplus beta must be >= 0 (0: ReLU), got " << shape.softplus_beta);
   JSA_CHECK(shape.code_layer == 0 || (shape.code_layer == 1 && shape.hidden_layers >= 1),
             "the code enters at layer 0 or 1 (after the first), got " << shape.code_layer);
   if (shape.code_size > 0) {
@@ -47,8 +49,10 @@ template <class T>
 Var Mlp<T>::forward(Tape<T>& t, Parameters<T>& params, Var x, Index value_rows, Var code) const {
   const Index rows = t.rows(x);
   if (value_rows < 0) value_rows = rows;
-  JSA_CHECK(t.cols(x) == shape_.in, "MLP expects " << shape_.in << " input columns, got " << t.cols(x));
-  JSA_CHECK(code.valid() == (code_weight_ >= 0), "a latent code is needed iff the MLP has code_size > 0");
+  JSA_CHECK(t.cols(x) == shape_.in,
+            "MLP expects " << shape_.in << " input columns, got " << t.cols(x));
+  JSA_CHECK(code.valid() == (code_weight_ >= 0),
+            "a latent code is needed iff the MLP has code_size > 0");
   Var h = x;
   for (size_t k = 0; k < weight_.size(); ++k) {
     Var bias = params.on(t, bias_[k]);

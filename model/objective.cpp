@@ -60,7 +60,8 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
   // With `dense`, phi6(x_P) finds its match in the whole pool (losses/chamfer.h).
   const Var generated = c.normals ? first_m(all.phi6) : first_m(all.points);
   const Var sampled = c.normals ? s6 : slice_cols(t, s6, 0, 3);
-  const Var surface = dense ? chamfer(t, generated, sampled, *dense) : chamfer(t, generated, sampled);
+  const Var surface =
+      dense ? chamfer(t, generated, sampled, *dense) : chamfer(t, generated, sampled);
   weighted.push_back({w.surface, surface});
   out.surface = double(t.scalar(surface));
 
@@ -103,15 +104,18 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
 
 template <class T>
 Var collection_objective(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>>& targets, Index m,
-                         Rng& rng, const ObjectiveOptions& o, LossTerms* terms, const std::vector<int>& batch,
+                         Rng& rng, const ObjectiveOptions& o, LossTerms* terms,
+                         const std::vector<int>& batch,
                          const std::vector<NearestIndex<T>>& surfaces) {
   const int n = atlas.shapes();
   const int b = int(targets.size());
   if (batch.empty())
     JSA_CHECK(b == n, targets.size() << " target sets for " << n << " shapes");
   else
-    JSA_CHECK(b == int(batch.size()) && b > 0 && b <= n, targets.size() << " target sets for a batch of " << batch.size());
-  JSA_CHECK(surfaces.empty() || int(surfaces.size()) == n, surfaces.size() << " surface indexes for " << n << " shapes");
+    JSA_CHECK(b == int(batch.size()) && b > 0 && b <= n,
+              targets.size() << " target sets for a batch of " << batch.size());
+  JSA_CHECK(surfaces.empty() || int(surfaces.size()) == n,
+            surfaces.size() << " surface indexes for " << n << " shapes");
   ObjectiveOptions per_shape = o;
   per_shape.components.repulsion = false;
   LossTerms sum_terms, one;
@@ -120,7 +124,8 @@ Var collection_objective(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>
     const int shape = batch.empty() ? k : batch[size_t(k)];
     JSA_CHECK(shape >= 0 && shape < n, "shape " << shape << " of " << n);
     const NearestIndex<T>* dense = surfaces.empty() ? nullptr : &surfaces[size_t(shape)];
-    const Var l = single_shape_objective(t, atlas, shape, targets[size_t(k)], m, rng, per_shape, &one, dense);
+    const Var l =
+        single_shape_objective(t, atlas, shape, targets[size_t(k)], m, rng, per_shape, &one, dense);
     total = k == 0 ? l : add(t, total, l);
     sum_terms.surface += one.surface / b;
     sum_terms.chart += one.chart / b;
@@ -153,14 +158,13 @@ Var collection_objective(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>
   return total;
 }
 
-#define JSA_INSTANTIATE(T)                                                                        \
+#define JSA_INSTANTIATE(T)                                                                       \
   template Var single_shape_objective<T>(Tape<T>&, Atlas<T>&, int, const Block<T>&, Index, Rng&, \
                                          const ObjectiveOptions&, LossTerms*,                    \
                                          const NearestIndex<T>*);                                \
-  template Var collection_objective<T>(Tape<T>&, Atlas<T>&, const std::vector<Block<T>>&, Index, \
-                                       Rng&, const ObjectiveOptions&, LossTerms*,              \
-                                       const std::vector<int>&,                                \
-                                       const std::vector<NearestIndex<T>>&);
+  template Var collection_objective<T>(                                                          \
+      Tape<T>&, Atlas<T>&, const std::vector<Block<T>>&, Index, Rng&, const ObjectiveOptions&,   \
+      LossTerms*, const std::vector<int>&, const std::vector<NearestIndex<T>>&);
 JSA_INSTANTIATE(float)
 JSA_INSTANTIATE(double)
 

@@ -16,12 +16,12 @@
 namespace jsa {
 
 struct LossWeights {
-  double surface = 1.0;     // l_6D, on L_6D (Eq. 7)
-  double chart = 1e-2;      // l_2D, on L_2D (Eq. 8)
-  double cycle = 1.0;       // l_cycle, on L_cycle (Eq. 9), mean convention (FitOptions: 0.1)
-  double isometry = 1e-4;   // l_iso, on L_iso (Eq. 10), mean convention
-  double repulsion = 1.0;   // l_rep, on L_rep (Eq. 11)
-  double code = 1e-4;       // collections: weight of the mean squared norm of the latent codes
+  double surface = 1.0;    // l_6D, on L_6D (Eq. 7)
+  double chart = 1e-2;     // l_2D, on L_2D (Eq. 8)
+  double cycle = 1.0;      // l_cycle, on L_cycle (Eq. 9), mean convention (FitOptions: 0.1)
+  double isometry = 1e-4;  // l_iso, on L_iso (Eq. 10), mean convention
+  double repulsion = 1.0;  // l_rep, on L_rep (Eq. 11)
+  double code = 1e-4;      // collections: weight of the mean squared norm of the latent codes
 };
 
 // Which parts of the method are on. The default is Table 1 row 11, the full method.
@@ -37,8 +37,7 @@ struct Components {
 
 // The value of each term at the last evaluation (unweighted), and the total.
 struct LossTerms {
-  double total = 0, surface = 0, chart = 0, cycle_2d = 0, cycle_6d = 0, isometry = 0,
-         repulsion = 0;
+  double total = 0, surface = 0, chart = 0, cycle_2d = 0, cycle_6d = 0, isometry = 0, repulsion = 0;
 };
 
 struct ObjectiveOptions {

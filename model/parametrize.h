@@ -12,10 +12,10 @@
 namespace jsa {
 
 struct SurfacePoints {
-  Var points;       // phi(x), M x 3
-  Var du, dv;       // J_u, J_v (Eq. 1), M x 3 each; invalid without Jacobians
-  Var normals;      // alpha-scaled unit normals n (Eq. 2), M x 3; invalid without Jacobians
-  Var phi6;         // [phi(x), n] (Eq. 3), M x 6; invalid without Jacobians
+  Var points;   // phi(x), M x 3
+  Var du, dv;   // J_u, J_v (Eq. 1), M x 3 each; invalid without Jacobians
+  Var normals;  // alpha-scaled unit normals n (Eq. 2), M x 3; invalid without Jacobians
+  Var phi6;     // [phi(x), n] (Eq. 3), M x 6; invalid without Jacobians
 };
 
 template <class T>

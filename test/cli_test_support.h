@@ -1,14 +1,15 @@
 // Running the jsatlas binary from tests: exit code and captured output.
 #pragma once
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <cstdlib>
 #include <string>
-#include <sys/wait.h>
 #include <vector>
-#include <unistd.h>
 
 namespace cli_test {
 

@@ -1,7 +1,6 @@
 // Tests of engine/adam.h: steps against the update rule written out by hand,
 // the step-decay schedule, and a small MLP fitted with the engine + Adam.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <iostream>
 
@@ -96,7 +95,8 @@ TEST_CASE("Adam over a buffer past the parallel grain matches the rule", "[adam]
       const double g = p.grads()[i];
       m[i] = 0.9 * m[i] + 0.1 * g;
       v[i] = 0.999 * v[i] + 0.001 * g * g;
-      theta[i] -= 1e-2 * (m[i] / (1 - std::pow(0.9, t))) / (std::sqrt(v[i] / (1 - std::pow(0.999, t))) + 1e-8);
+      theta[i] -= 1e-2 * (m[i] / (1 - std::pow(0.9, t))) /
+                  (std::sqrt(v[i] / (1 - std::pow(0.999, t))) + 1e-8);
     }
   }
   double worst = 0;
@@ -171,8 +171,8 @@ TEST_CASE("a 2-32-32-3 MLP fits a smooth 2D -> 3D function with Adam", "[adam][t
     adam.step(p, step_decay(1e-2, it, {1000}, 0.1));
   }
   const float final_loss = step(false);
-  std::cout << "  2-32-32-3 MLP + Adam, " << iterations << " steps on " << n
-            << " points: MSE " << initial << " -> " << final_loss << std::endl;
+  std::cout << "  2-32-32-3 MLP + Adam, " << iterations << " steps on " << n << " points: MSE "
+            << initial << " -> " << final_loss << std::endl;
   // Measured: MSE 0.64 -> 9.0e-5 (float, this seed). Threshold 1e-3: 10x margin.
   CHECK(final_loss < 1e-3f);
   CHECK(final_loss < initial / 100);

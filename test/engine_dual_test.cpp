@@ -1,6 +1,5 @@
 // Tests of engine/dual.h: each rule against a derivative known in closed form.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
 #include "engine/dual.h"

@@ -33,7 +33,8 @@ inline Block<double> uniform_block(Rng& rng, Index rows, Index cols, double lo, 
 
 // Entries with |x| in [lo, hi) and a random sign: bounded away from 0, so ReLU
 // kinks and sqrt(0) are never within a finite-difference step.
-inline Block<double> signed_block(Rng& rng, Index rows, Index cols, double lo = 0.2, double hi = 1.0) {
+inline Block<double> signed_block(Rng& rng, Index rows, Index cols, double lo = 0.2,
+                                  double hi = 1.0) {
   Block<double> b = uniform_block(rng, rows, cols, lo, hi);
   for (Index i = 0; i < b.size(); ++i)
     if (rng.uniform() < 0.5) b.data()[i] = -b.data()[i];

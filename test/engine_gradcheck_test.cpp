@@ -29,8 +29,8 @@ Block<double> input() {
 }  // namespace
 
 TEST_CASE("check_gradients passes a correct pull-back", "[gradcheck]") {
-  const auto r = check_gradients([](Tape<double>& t, const std::vector<Var>& v) { return cube(t, v[0], 1.0); },
-                                 {input()});
+  const auto r = check_gradients(
+      [](Tape<double>& t, const std::vector<Var>& v) { return cube(t, v[0], 1.0); }, {input()});
   INFO(r.report);
   CHECK(r.ok);
   CHECK(r.checked == 6);
@@ -52,7 +52,8 @@ TEST_CASE("check_gradients catches a missing path (one input ignored)", "[gradch
     Var a = v[0], b = v[1];
     Var y = t.node(t.rows(a), t.cols(a), {a, b});
     t.value(y) = t.value(a).cwiseProduct(t.value(b));
-    t.on_backward(y, [a, b](Tape<double>& t, Var y) { t.grad(a) += t.grad(y).cwiseProduct(t.value(b)); });
+    t.on_backward(
+        y, [a, b](Tape<double>& t, Var y) { t.grad(a) += t.grad(y).cwiseProduct(t.value(b)); });
     return y;
   };
   const auto r = check_gradients(f, {input(), input()});

@@ -7,7 +7,6 @@
 // step 1e-6. Central differences on these smooth, O(1) graphs are accurate to
 // ~1e-9, so the margin is wide.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -50,7 +49,8 @@ std::vector<GradCase> op_cases() {
   // part, where the second derivative (the tangent rows' pull-back into z) matters.
   add_case("softplus_stacked", [n](T& t, const Vs& x) { return softplus_stacked(t, x[0], n, 3.0); },
            {signed_block(rng, 3 * n, c)});
-  add_case("softplus_stacked (plain rows)", [n](T& t, const Vs& x) { return softplus_stacked(t, x[0], n, 0.5); },
+  add_case("softplus_stacked (plain rows)",
+           [n](T& t, const Vs& x) { return softplus_stacked(t, x[0], n, 0.5); },
            {signed_block(rng, n, c)});
 
   // ---- elementwise, all four broadcast shapes of b ----
@@ -67,11 +67,14 @@ std::vector<GradCase> op_cases() {
     add_case(std::string("mul ") + s.name, [](T& t, const Vs& x) { return mul(t, x[0], x[1]); },
              {signed_block(rng, n, c), signed_block(rng, s.rows, s.cols)});
   }
-  add_case("scale", [](T& t, const Vs& x) { return scale(t, x[0], -2.5); }, {signed_block(rng, n, c)});
-  add_case("offset", [](T& t, const Vs& x) { return offset(t, x[0], 0.7); }, {signed_block(rng, n, c)});
+  add_case("scale", [](T& t, const Vs& x) { return scale(t, x[0], -2.5); },
+           {signed_block(rng, n, c)});
+  add_case("offset", [](T& t, const Vs& x) { return offset(t, x[0], 0.7); },
+           {signed_block(rng, n, c)});
   add_case("square", [](T& t, const Vs& x) { return square(t, x[0]); }, {signed_block(rng, n, c)});
   // x in [0.5, 2): far from sqrt's singular derivative at 0.
-  add_case("sqrt", [](T& t, const Vs& x) { return sqrt(t, x[0]); }, {uniform_block(rng, n, c, 0.5, 2.0)});
+  add_case("sqrt", [](T& t, const Vs& x) { return sqrt(t, x[0]); },
+           {uniform_block(rng, n, c, 0.5, 2.0)});
   add_case("exp", [](T& t, const Vs& x) { return exp(t, x[0]); }, {signed_block(rng, n, c)});
 
   // ---- rows and columns ----
@@ -86,17 +89,21 @@ std::vector<GradCase> op_cases() {
   // Row 2 is gathered three times and row 3 never: the pull-back must add three
   // gradients into row 2 and leave row 3 at zero.
   add_case("gather_rows (repeats)",
-           [](T& t, const Vs& x) { return gather_rows(t, x[0], {2, 0, 2, 4, 2, 1}); },
+           [](T& t, const Vs& x) {
+             return gather_rows(t, x[0], {2, 0, 2, 4, 2, 1});
+           },
            {signed_block(rng, n, c)});
 
   // ---- reductions and per-row geometry ----
   add_case("sum", [](T& t, const Vs& x) { return sum(t, x[0]); }, {signed_block(rng, n, c)});
   add_case("mean", [](T& t, const Vs& x) { return mean(t, x[0]); }, {signed_block(rng, n, c)});
-  add_case("row_sum", [](T& t, const Vs& x) { return row_sum(t, x[0]); }, {signed_block(rng, n, c)});
+  add_case("row_sum", [](T& t, const Vs& x) { return row_sum(t, x[0]); },
+           {signed_block(rng, n, c)});
   add_case("row_dot", [](T& t, const Vs& x) { return row_dot(t, x[0], x[1]); },
            {signed_block(rng, n, c), signed_block(rng, n, c)});
   // Rows with every |x_ij| >= 0.2 have norm >= 0.4: far from the kink at 0.
-  add_case("row_norm", [](T& t, const Vs& x) { return row_norm(t, x[0]); }, {signed_block(rng, n, c)});
+  add_case("row_norm", [](T& t, const Vs& x) { return row_norm(t, x[0]); },
+           {signed_block(rng, n, c)});
   add_case("row_normalize", [](T& t, const Vs& x) { return row_normalize(t, x[0]); },
            {signed_block(rng, n, 3)});
   add_case("cross3", [](T& t, const Vs& x) { return cross3(t, x[0], x[1]); },
@@ -255,8 +262,9 @@ TEST_CASE("shape errors are programmer errors", "[ops][errors]") {
   Var a = t.constant(Block<double>::Ones(3, 4));
   CHECK_THROWS_AS(add(t, a, t.constant(Block<double>::Ones(2, 4))), InternalError);
   CHECK_THROWS_AS(linear(t, a, t.constant(Block<double>::Ones(3, 2)), Var{}), InternalError);
-  CHECK_THROWS_AS(linear(t, a, t.constant(Block<double>::Ones(4, 2)), t.constant(Block<double>::Ones(1, 2)), 5),
-                  InternalError);  // bias on more rows than there are
+  CHECK_THROWS_AS(
+      linear(t, a, t.constant(Block<double>::Ones(4, 2)), t.constant(Block<double>::Ones(1, 2)), 5),
+      InternalError);  // bias on more rows than there are
   CHECK_THROWS_AS(relu_masked(t, a, 2), InternalError);
   CHECK_THROWS_AS(slice_cols(t, a, 2, 3), InternalError);
   CHECK_THROWS_AS(gather_rows(t, a, {0, 3}), InternalError);
@@ -314,15 +322,18 @@ TEST_CASE("tall blocks (parallel path) equal a plain loop", "[ops][parallel]") {
 // float and double instantiations compute the same thing (to float precision).
 TEST_CASE("float ops agree with double ops", "[ops][float]") {
   Rng rng(23);
-  const Block<double> x0 = signed_block(rng, 9, 3), w0 = signed_block(rng, 3, 3), b0 = signed_block(rng, 1, 3);
+  const Block<double> x0 = signed_block(rng, 9, 3), w0 = signed_block(rng, 3, 3),
+                      b0 = signed_block(rng, 1, 3);
   auto run = [&](auto scalar) {
     using S = decltype(scalar);
     Tape<S> t;
     Var x = t.variable(x0.cast<S>());
-    Var h = relu_masked(t, linear(t, stack_tangents(t, x), t.constant(w0.cast<S>()), t.constant(b0.cast<S>()), 9),
-                        9);
+    Var h = relu_masked(
+        t, linear(t, stack_tangents(t, x), t.constant(w0.cast<S>()), t.constant(b0.cast<S>()), 9),
+        9);
     Var loss = mean(t, row_norm(t, cross3(t, slice_rows(t, h, 9, 9), slice_rows(t, h, 18, 9))));
-    loss = add(t, loss, mean(t, exp(t, scale(t, row_normalize(t, slice_rows(t, h, 0, 9)), S(0.5)))));
+    loss =
+        add(t, loss, mean(t, exp(t, scale(t, row_normalize(t, slice_rows(t, h, 0, 9)), S(0.5)))));
     t.backward(loss);
     return std::make_pair(double(t.scalar(loss)), Block<double>(t.grad(x).template cast<double>()));
   };
@@ -341,8 +352,10 @@ namespace jsa::test {
 TEST_CASE("the same graph twice gives bitwise-identical gradients", "[ops][determinism]") {
   Rng rng(31);
   const Index n = 4000;
-  const Block<float> x0 = signed_block(rng, n, 2).cast<float>(), w1 = signed_block(rng, 2, 64).cast<float>(),
-                     b1 = signed_block(rng, 1, 64).cast<float>(), w2 = signed_block(rng, 64, 3).cast<float>();
+  const Block<float> x0 = signed_block(rng, n, 2).cast<float>(),
+                     w1 = signed_block(rng, 2, 64).cast<float>(),
+                     b1 = signed_block(rng, 1, 64).cast<float>(),
+                     w2 = signed_block(rng, 64, 3).cast<float>();
   auto run = [&] {
     Tape<float> t;
     Var w = t.variable(w1), b = t.variable(b1), v = t.variable(w2);
@@ -350,7 +363,8 @@ TEST_CASE("the same graph twice gives bitwise-identical gradients", "[ops][deter
     const Stacked s = unstack(t, linear(t, h, v, Var{}, n));
     Var loss = add(t, mean(t, row_norm(t, cross3(t, s.du, s.dv))), mean(t, square(t, s.value)));
     t.backward(loss);
-    return std::make_tuple(Block<float>(t.grad(w)), Block<float>(t.grad(b)), Block<float>(t.grad(v)));
+    return std::make_tuple(Block<float>(t.grad(w)), Block<float>(t.grad(b)),
+                           Block<float>(t.grad(v)));
   };
   const auto first = run(), second = run();
   CHECK(std::get<0>(first) == std::get<0>(second));

@@ -1,7 +1,6 @@
 // Tests of engine/parallel.h: parallel_rows covers [0, n) exactly once in
 // grain-sized ranges, whatever n is relative to the grain.
 #include <catch2/catch.hpp>
-
 #include <vector>
 
 #include "engine/parallel.h"
@@ -22,7 +21,8 @@ TEST_CASE("parallel_rows covers every row exactly once", "[parallel]") {
 TEST_CASE("parallel_rows hands out ranges of at most grain rows", "[parallel]") {
   const Index n = 1000, grain = 64;
   std::vector<Index> sizes(size_t((n + grain - 1) / grain), -1);
-  parallel_rows(n, [&](Index r0, Index r1) { sizes[size_t(r0 / grain)] = r1 - r0; }, grain);
+  parallel_rows(
+      n, [&](Index r0, Index r1) { sizes[size_t(r0 / grain)] = r1 - r0; }, grain);
   for (size_t c = 0; c + 1 < sizes.size(); ++c) CHECK(sizes[c] == grain);
   CHECK(sizes.back() == n % grain);
 }

@@ -2,7 +2,6 @@
 // flowing from the tape into the buffer, and save/load (round trip, and every
 // kind of bad file throwing jsa::InputError).
 #include <catch2/catch.hpp>
-
 #include <sstream>
 
 #include "engine/ops.h"
@@ -95,7 +94,8 @@ TEST_CASE("bad parameter files throw InputError naming the file", "[parameters][
     p.add("layer0.bias", 1, 3);
     p.add("layer1.weight", 3, 1);
     CHECK_THROWS_AS(load_into(p, good), InputError);
-    CHECK_THROWS_WITH(load_into(p, good), Catch::Contains("model.bin") && Catch::Contains("layer0.weight"));
+    CHECK_THROWS_WITH(load_into(p, good),
+                      Catch::Contains("model.bin") && Catch::Contains("layer0.weight"));
   }
   SECTION("unknown name") {
     Parameters<float> p;
@@ -111,7 +111,8 @@ TEST_CASE("bad parameter files throw InputError naming the file", "[parameters][
     CHECK_THROWS_AS(load_into(p, good), InputError);
   }
   SECTION("truncated anywhere") {
-    for (size_t cut : {size_t(0), size_t(2), size_t(4), size_t(10), good.size() / 2, good.size() - 1}) {
+    for (size_t cut :
+         {size_t(0), size_t(2), size_t(4), size_t(10), good.size() / 2, good.size() - 1}) {
       Parameters<float> p = two_layer();
       INFO("cut at byte " << cut << " of " << good.size());
       CHECK_THROWS_AS(load_into(p, good.substr(0, cut)), InputError);
@@ -120,7 +121,9 @@ TEST_CASE("bad parameter files throw InputError naming the file", "[parameters][
   SECTION("a name twice (so another is missing)") {
     // count = 2, then "a" 1x1 twice, written field by field as save() does.
     std::ostringstream out;
-    auto put = [&](const void* q, size_t n) { out.write(static_cast<const char*>(q), std::streamsize(n)); };
+    auto put = [&](const void* q, size_t n) {
+      out.write(static_cast<const char*>(q), std::streamsize(n));
+    };
     const uint32_t count = 2, len = 1;
     const int64_t one = 1;
     const float value = 3.0f;

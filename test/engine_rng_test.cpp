@@ -8,7 +8,6 @@
 //   normal mean    0   +- 0.01    (s.e. 2.2e-3)
 //   normal var     1   +- 0.015   (s.e. sqrt(2 / n) = 3.2e-3)
 #include <catch2/catch.hpp>
-
 #include <set>
 
 #include "engine/check.h"

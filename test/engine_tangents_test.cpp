@@ -2,9 +2,8 @@
 // MLP against two independent oracles (Dual<double, 2> forward mode, and central
 // differences of the value output), then gradients *through* the Jacobian (the
 // normals of Eq. 2 and the J^T J isometry term of Eq. 10) against check_gradients.
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 
 #include "engine/dual.h"
@@ -33,7 +32,9 @@ std::vector<Block<double>> mlp_weights(uint64_t seed) {
 // p = {W1, b1, W2, b2, W3, b3}. beta = 0: ReLU; beta > 0: softplus.
 Stacked mlp_stacked(Tape<double>& t, Var x, const std::vector<Var>& p, double beta = 0) {
   const Index n = t.rows(x);
-  auto act = [&](Var z) { return beta > 0 ? softplus_stacked(t, z, n, beta) : relu_masked(t, z, n); };
+  auto act = [&](Var z) {
+    return beta > 0 ? softplus_stacked(t, z, n, beta) : relu_masked(t, z, n);
+  };
   Var h = stack_tangents(t, x);
   h = act(linear(t, h, p[0], p[1], n));
   h = act(linear(t, h, p[2], p[3], n));
@@ -92,15 +93,16 @@ std::vector<GradCase> jacobian_cases() {
                    },
                    inputs, o});
   // mean((E - 1)^2 + (G - 1)^2 + 2 F^2) with E = J_u.J_u, F = J_u.J_v, G = J_v.J_v.
-  cases.push_back({"MLP J^T J isometry (weights + points)",
-                   [](Tape<double>& t, const std::vector<Var>& v) {
-                     const Stacked s = mlp_stacked(t, v[0], {v.begin() + 1, v.end()});
-                     Var e = row_dot(t, s.du, s.du), f = row_dot(t, s.du, s.dv), g = row_dot(t, s.dv, s.dv);
-                     Var iso = add(t, add(t, square(t, offset(t, e, -1.0)), square(t, offset(t, g, -1.0))),
-                                   scale(t, square(t, f), 2.0));
-                     return mean(t, iso);
-                   },
-                   inputs, o});
+  cases.push_back(
+      {"MLP J^T J isometry (weights + points)",
+       [](Tape<double>& t, const std::vector<Var>& v) {
+         const Stacked s = mlp_stacked(t, v[0], {v.begin() + 1, v.end()});
+         Var e = row_dot(t, s.du, s.du), f = row_dot(t, s.du, s.dv), g = row_dot(t, s.dv, s.dv);
+         Var iso = add(t, add(t, square(t, offset(t, e, -1.0)), square(t, offset(t, g, -1.0))),
+                       scale(t, square(t, f), 2.0));
+         return mean(t, iso);
+       },
+       inputs, o});
   // The value rows too, so the check also sees d(loss)/d(points) non-zero (a ReLU
   // net's J is piecewise constant in x, so the two losses above have zero
   // gradient w.r.t. the points: checked, but trivially).
@@ -119,14 +121,15 @@ std::vector<GradCase> jacobian_cases() {
                      return row_normalize(t, cross3(t, s.du, s.dv));
                    },
                    inputs, o});
-  cases.push_back({"softplus MLP J^T J isometry (weights + points)",
-                   [](Tape<double>& t, const std::vector<Var>& v) {
-                     const Stacked s = mlp_stacked(t, v[0], {v.begin() + 1, v.end()}, 2.0);
-                     Var e = row_dot(t, s.du, s.du), f = row_dot(t, s.du, s.dv), g = row_dot(t, s.dv, s.dv);
-                     return mean(t, add(t, add(t, square(t, offset(t, e, -1.0)), square(t, offset(t, g, -1.0))),
-                                        scale(t, square(t, f), 2.0)));
-                   },
-                   inputs, o});
+  cases.push_back(
+      {"softplus MLP J^T J isometry (weights + points)",
+       [](Tape<double>& t, const std::vector<Var>& v) {
+         const Stacked s = mlp_stacked(t, v[0], {v.begin() + 1, v.end()}, 2.0);
+         Var e = row_dot(t, s.du, s.du), f = row_dot(t, s.du, s.dv), g = row_dot(t, s.dv, s.dv);
+         return mean(t, add(t, add(t, square(t, offset(t, e, -1.0)), square(t, offset(t, g, -1.0))),
+                            scale(t, square(t, f), 2.0)));
+       },
+       inputs, o});
   return cases;
 }
 
@@ -207,11 +210,13 @@ TEST_CASE("softplus stacked tangents equal finite differences of the value", "[t
       const Block<double> g = tp.value(mlp_stacked(tp, tp.constant(xs), pp, beta).value);
       for (Index c = 0; c < 3; ++c) {
         const double fd_u = (g(0, c) - g(1, c)) / (2 * h), fd_v = (g(2, c) - g(3, c)) / (2 * h);
-        worst = std::max({worst, std::abs(t.value(s.du)(i, c) - fd_u), std::abs(t.value(s.dv)(i, c) - fd_v)});
+        worst = std::max(
+            {worst, std::abs(t.value(s.du)(i, c) - fd_u), std::abs(t.value(s.dv)(i, c) - fd_v)});
         largest = std::max({largest, std::abs(fd_u), std::abs(fd_v)});
       }
     }
-    INFO("beta " << beta << ": max |tape - finite difference| " << worst << ", largest entry " << largest);
+    INFO("beta " << beta << ": max |tape - finite difference| " << worst << ", largest entry "
+                 << largest);
     CHECK(worst < 1e-6);
     CHECK(largest > 0.1);
   }
@@ -247,17 +252,19 @@ TEST_CASE("softplus stacked-tangent Jacobian equals Dual<double,2>", "[tangents]
 TEST_CASE("softplus values, and ReLU as beta grows", "[ops]") {
   Tape<double> t;
   Block<double> z(2, 3);
-  z << -2, 0, 3,  //
+  z << -2, 0, 3,       //
       0.5, -800, 800;  // exp(800) would overflow without the stable form
   Block<double> y = t.value(softplus_stacked(t, t.constant(z), 2, 1.0));
   for (Index i = 0; i < 2; ++i)
     for (Index j = 0; j < 3; ++j) {
-      const double expect = std::abs(z(i, j)) > 50 ? std::max(z(i, j), 0.0) : std::log1p(std::exp(z(i, j)));
+      const double expect =
+          std::abs(z(i, j)) > 50 ? std::max(z(i, j), 0.0) : std::log1p(std::exp(z(i, j)));
       CHECK(y(i, j) == Approx(expect).margin(1e-300));
     }
   const Block<double> r = t.value(relu_masked(t, t.constant(z), 2));
   const Block<double> sharp = t.value(softplus_stacked(t, t.constant(z), 2, 1e4));
-  CHECK((sharp - r).cwiseAbs().maxCoeff() < std::log(2.0) / 1e4 + 1e-12);  // the gap is largest at z = 0
+  CHECK((sharp - r).cwiseAbs().maxCoeff() <
+        std::log(2.0) / 1e4 + 1e-12);  // the gap is largest at z = 0
   CHECK_THROWS_AS(softplus_stacked(t, t.constant(z), 2, 0.0), InternalError);
 }
 

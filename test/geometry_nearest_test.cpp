@@ -70,12 +70,12 @@ TEMPLATE_TEST_CASE("nearest matches brute force in 2, 3, 5 and 6 columns", "[nea
                              random_block<TestType>(300, 2, 6));
 }
 
-TEMPLATE_TEST_CASE("a NearestIndex built once answers like nearest() on every query", "[nearest]", float,
-                   double) {
+TEMPLATE_TEST_CASE("a NearestIndex built once answers like nearest() on every query", "[nearest]",
+                   float, double) {
   for (Index c : {2, 3, 5, 6}) {
     INFO("columns " << c);
-    const Block<TestType> points = c == 6 ? points_with_normals<TestType>(1500, 20)
-                                          : random_block<TestType>(1500, c, 21 + c);
+    const Block<TestType> points =
+        c == 6 ? points_with_normals<TestType>(1500, 20) : random_block<TestType>(1500, c, 21 + c);
     const NearestIndex<TestType> index(points);
     CHECK(index.points() == points);
     // Several query sets against the one tree, each checked against the oracle.
@@ -88,7 +88,8 @@ TEMPLATE_TEST_CASE("a NearestIndex built once answers like nearest() on every qu
       nearest_brute_force(q, points, oracle, &oracle_dist);
       REQUIRE(got.size() == size_t(q.rows()));
       CHECK(got == oracle);
-      for (Index i = 0; i < q.rows(); ++i) CHECK(dist[i] == Approx(oracle_dist[i]).epsilon(1e-5).margin(1e-12));
+      for (Index i = 0; i < q.rows(); ++i)
+        CHECK(dist[i] == Approx(oracle_dist[i]).epsilon(1e-5).margin(1e-12));
     }
   }
   // Moving the index keeps the tree valid (it points into the moved-from storage).

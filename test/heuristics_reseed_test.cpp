@@ -5,13 +5,12 @@
 // half's components must move to the upper half's border with it, the others
 // must stay, and only the moved means lose their Adam moments.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
-#include "model/tool/domain_mesh.h"
 #include "model/heuristics/reseed.h"
-#include "model/tool/trainer.h"
 #include "model/heuristics/wrap.h"
+#include "model/tool/domain_mesh.h"
+#include "model/tool/trainer.h"
 #include "test/sphere_pool.h"
 
 using namespace jsa;
@@ -53,7 +52,8 @@ struct WrappedSphere {
 
 }  // namespace
 
-TEST_CASE("reseed_flipped_means: a flipped half's components move to the border of the other half", "[reseed]") {
+TEST_CASE("reseed_flipped_means: a flipped half's components move to the border of the other half",
+          "[reseed]") {
   WrappedSphere sphere(1024, 20000, 800);
   Atlas<float>& atlas = sphere.atlas;
   Block<float>& pool = sphere.pool;
@@ -79,7 +79,8 @@ TEST_CASE("reseed_flipped_means: a flipped half's components move to the border 
   const size_t offset = atlas.params.entry(atlas.domain.means()).offset;
   int moved = 0, moved_from_below = 0, stayed_below = 0;
   for (Index k = 0; k < mu.rows(); ++k) {
-    const bool same = mu(k, 0) == before[offset + size_t(2 * k)] && mu(k, 1) == before[offset + size_t(2 * k) + 1];
+    const bool same = mu(k, 0) == before[offset + size_t(2 * k)] &&
+                      mu(k, 1) == before[offset + size_t(2 * k) + 1];
     const double z_before = z0[size_t(k)], z_after = z1[size_t(k)];
     if (same) {
       // A component well below the equator cannot have stayed.
@@ -101,7 +102,8 @@ TEST_CASE("reseed_flipped_means: a flipped half's components move to the border 
   CHECK(stayed_below == 0);
   // Only the means changed: phi and psi are untouched.
   for (size_t i = 0; i < before.size(); ++i)
-    if (i < offset || i >= offset + size_t(2 * mu.rows())) REQUIRE(atlas.params.values()[i] == before[i]);
+    if (i < offset || i >= offset + size_t(2 * mu.rows()))
+      REQUIRE(atlas.params.values()[i] == before[i]);
 
   // The moved components sit on the border (about half their samples cross it),
   // so the back-facing fraction of all samples drops from 1/2 to about 1/4.
@@ -112,7 +114,8 @@ TEST_CASE("reseed_flipped_means: a flipped half's components move to the border 
   CHECK(second.back_facing < 0.35);
 }
 
-TEST_CASE("reseed_flipped_means: a correct atlas is left alone; the trainer's schedule", "[reseed]") {
+TEST_CASE("reseed_flipped_means: a correct atlas is left alone; the trainer's schedule",
+          "[reseed]") {
   WrappedSphere sphere(256, 5000, 600);
   Atlas<float>& atlas = sphere.atlas;
   const Block<float>& pool = sphere.pool;

@@ -2,14 +2,13 @@
 // outward, with its seams where the header says; the ellipsoid of a point set
 // has the set's axes and half-widths; the fit puts phi on the wrap with outward
 // normals and psi near its inverse.
-#include <catch2/catch.hpp>
-
 #include <Eigen/Dense>
+#include <catch2/catch.hpp>
 #include <cmath>
 
 #include "model/heuristics/orientation.h"
-#include "model/tool/trainer.h"
 #include "model/heuristics/wrap.h"
+#include "model/tool/trainer.h"
 #include "test/sphere_pool.h"
 
 using namespace jsa;
@@ -25,7 +24,8 @@ Eigen::Vector3d sphere_at(double u, double v) {
 
 }  // namespace
 
-TEST_CASE("octahedral_sphere: on the sphere, outward, seams paired on the square's edges", "[wrap]") {
+TEST_CASE("octahedral_sphere: on the sphere, outward, seams paired on the square's edges",
+          "[wrap]") {
   Rng rng(5);
   int checked = 0;
   for (int i = 0; i < 2000; ++i) {
@@ -38,7 +38,8 @@ TEST_CASE("octahedral_sphere: on the sphere, outward, seams paired on the square
     // J_u x J_v by central differences points outward (Eq. 2's convention),
     // away from the fold lines |s| + |t| = 1 and s = 0, t = 0 where W has kinks.
     const double s = 2 * u - 1, t = 2 * v - 1, h = 1e-6;
-    if (std::abs(std::abs(s) + std::abs(t) - 1) < 1e-3 || std::abs(s) < 1e-3 || std::abs(t) < 1e-3) continue;
+    if (std::abs(std::abs(s) + std::abs(t) - 1) < 1e-3 || std::abs(s) < 1e-3 || std::abs(t) < 1e-3)
+      continue;
     const Eigen::Vector3d ju = (sphere_at(u + h, v) - sphere_at(u - h, v)) / (2 * h);
     const Eigen::Vector3d jv = (sphere_at(u, v + h) - sphere_at(u, v - h)) / (2 * h);
     CHECK(ju.cross(jv).dot(q) > 0);
@@ -89,7 +90,8 @@ TEST_CASE("enclosing_ellipsoid: a box's axes and half-widths, a right-handed fra
   Eigen::Matrix3d r;
   for (int i = 0; i < 3; ++i)
     for (int k = 0; k < 3; ++k) r(i, k) = e.axes[i][k];
-  CHECK(std::abs(std::abs(r(0, 0) * c + r(1, 0) * s) - 1) < 1e-3);  // first axis along the long side
+  CHECK(std::abs(std::abs(r(0, 0) * c + r(1, 0) * s) - 1) <
+        1e-3);  // first axis along the long side
   CHECK(r.determinant() == Approx(1).epsilon(1e-9));
   // A flat set keeps a fifth of its largest radius, so the wrap stays a closed surface.
   for (Index i = 0; i < pool.rows(); ++i) pool(i, 2) = 0.5f;
@@ -127,8 +129,8 @@ TEST_CASE("wrap_initialize: phi lands on the wrap facing out, psi near its inver
   const WrapReport r = wrap_initialize(atlas, {pool}, 800, 1000, 2e-3, rng);
   Rng check(10);
   const double after = back_facing_fraction(atlas, pool, 2000, check);
-  INFO("RMS error phi " << r.phi_error << ", psi " << r.psi_error << "; back-facing before " << before
-                        << ", after " << after);
+  INFO("RMS error phi " << r.phi_error << ", psi " << r.psi_error << "; back-facing before "
+                        << before << ", after " << after);
   CHECK(r.phi_error < 0.05);  // of a radius-0.5 sphere
   CHECK(r.psi_error < 0.12);  // psi cannot follow the seams exactly
   CHECK(after < 0.03);

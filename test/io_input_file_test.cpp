@@ -10,15 +10,12 @@
 
 #include "engine/check.h"
 #include "io/input_file.h"
-
 #include "test/scratch.h"
 
-using test_support::ScratchDir;
 using test_support::message_of;
+using test_support::ScratchDir;
 
-namespace {
-
-}  // namespace
+namespace {}  // namespace
 
 TEST_CASE("read_input_file returns the bytes of a file", "[io][input_file]") {
   ScratchDir dir;

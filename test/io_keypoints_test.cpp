@@ -7,7 +7,8 @@
 using test_support::message_of;
 using test_support::ScratchDir;
 
-TEST_CASE("keypoints: the index of each line, in order; coordinates are ignored", "[io][keypoints]") {
+TEST_CASE("keypoints: the index of each line, in order; coordinates are ignored",
+          "[io][keypoints]") {
   ScratchDir dir("vts");
   const std::string f = dir.file("a.vts", "# comment\n12 0.1 0.2 0.3\n\n0 9 9 9\n7\n");
   CHECK(jsa::read_keypoints(f, 13) == std::vector<int>{12, 0, 7});

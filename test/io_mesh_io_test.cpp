@@ -10,11 +10,10 @@
 #include "engine/check.h"
 #include "io/geometry/builtin_shapes.h"
 #include "io/mesh_io.h"
-
 #include "test/scratch.h"
 
-using test_support::ScratchDir;
 using test_support::message_of;
+using test_support::ScratchDir;
 
 namespace {
 

@@ -5,11 +5,10 @@
 
 #include "engine/check.h"
 #include "io/mesh_validation.h"
-
 #include "test/scratch.h"
 
-using test_support::ScratchDir;
 using test_support::message_of;
+using test_support::ScratchDir;
 
 namespace {
 

@@ -15,11 +15,10 @@
 #include "engine/check.h"
 #include "engine/rng.h"
 #include "io/mesh_io.h"
-
 #include "test/scratch.h"
 
-using test_support::ScratchDir;
 using test_support::message_of;
+using test_support::ScratchDir;
 
 namespace {
 
@@ -316,18 +315,19 @@ TEST_CASE("fuzz regressions: PLY list lengths past int64 and rows without proper
   }
   SECTION("an element without properties takes no ascii lines") {
     // Rows of an element with no properties used to swallow the next element's lines.
-    const std::string path = dir.file(
-        "empty_element.ply", "ply\nformat ascii 1.0\nelement nothing 2\n" + vertex_header +
-                                 "element face 1\nproperty list uchar int vertex_indices\n"
-                                 "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    const std::string path =
+        dir.file("empty_element.ply", "ply\nformat ascii 1.0\nelement nothing 2\n" + vertex_header +
+                                          "element face 1\nproperty list uchar int vertex_indices\n"
+                                          "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
     const jsa::Mesh mesh = jsa::read_shape(path);
     CHECK(mesh.vertices.rows() == 3);
     CHECK(mesh.faces.rows() == 1);
   }
   SECTION("a binary element of 10^15 rows without properties is read at once") {
     std::string bytes = "ply\nformat binary_little_endian 1.0\nelement nothing 1000000000000000\n" +
-                        vertex_header + "element face 1\nproperty list uchar int vertex_indices\n"
-                                        "end_header\n";
+                        vertex_header +
+                        "element face 1\nproperty list uchar int vertex_indices\n"
+                        "end_header\n";
     const float xyz[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
     bytes.append(reinterpret_cast<const char*>(xyz), sizeof xyz);
     const std::int32_t face[3] = {0, 1, 2};

@@ -201,7 +201,8 @@ TEST_CASE("dense chamfer: x searches the pool, y searches x", "[chamfer]") {
     // The pool is far denser than y, so the dense first term is smaller.
     CHECK(one_way(x, pool) < one_way(x, y));
     for (Index i = 0; i < x.rows(); ++i)
-      CHECK(m.x_squared_distance[size_t(i)] == Approx((x.row(i) - pool.row(m.x_to_y[size_t(i)])).squaredNorm()));
+      CHECK(m.x_squared_distance[size_t(i)] ==
+            Approx((x.row(i) - pool.row(m.x_to_y[size_t(i)])).squaredNorm()));
   }
   // When the pool is y itself, the dense op is Eq. (6) exactly, gradients too.
   const Block<double> x = random_block(60, 6, 830), y = random_block(50, 6, 831);
@@ -222,7 +223,8 @@ TEST_CASE("dense chamfer gradient passes the finite-difference check", "[chamfer
   REQUIRE(smallest_match_gap(y, x) > 1e-4);
   const NearestIndex<double> surface(pool);
   const GradCheckResult r = check_gradients(
-      [&](Tape<double>& t, const std::vector<Var>& v) { return chamfer(t, v[0], v[1], surface); }, {x, y});
+      [&](Tape<double>& t, const std::vector<Var>& v) { return chamfer(t, v[0], v[1], surface); },
+      {x, y});
   INFO(r.report);
   CHECK(r.ok);
 }

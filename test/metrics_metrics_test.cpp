@@ -1,10 +1,9 @@
 // surface_metrics (Table 1's Chamfer columns) on sets whose answer is known by
 // construction: a grid against itself, shifted, and with flipped normals.
-#include <cmath>
+#include "losses/metrics/metrics.h"
 
 #include <catch2/catch.hpp>
-
-#include "losses/metrics/metrics.h"
+#include <cmath>
 
 using namespace jsa;
 

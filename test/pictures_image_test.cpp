@@ -73,8 +73,8 @@ TEST_CASE("write_png reports a missing directory as bad input", "[image]") {
 }
 
 TEST_CASE("read_image decodes what write_png wrote, and rejects what is not an image", "[image]") {
-  const std::string base = std::filesystem::temp_directory_path() /
-                           ("jsatlas_read_image_" + std::to_string(::getpid()));
+  const std::string base =
+      std::filesystem::temp_directory_path() / ("jsatlas_read_image_" + std::to_string(::getpid()));
   jsa::Image image(13, 7, jsa::colours::white());
   image.set(3, 2, {0.2, 0.4, 0.6});
   image.set(12, 6, {1, 0, 0});
@@ -99,7 +99,8 @@ TEST_CASE("read_image decodes what write_png wrote, and rejects what is not an i
   } catch (const jsa::InputError& e) {
     CHECK(std::string(e.what()).find("20000 x 1 pixels") != std::string::npos);
   }
-  for (const char* ext : {".png", ".txt", "_empty.png", "_huge.png"}) std::filesystem::remove(base + ext);
+  for (const char* ext : {".png", ".txt", "_empty.png", "_huge.png"})
+    std::filesystem::remove(base + ext);
 }
 
 TEST_CASE("pixels: set, get, blend, clipping", "[image]") {

@@ -90,7 +90,8 @@ using KdTree = nanoflann::KDTreeSingleIndexAdaptor<SquaredL2<T, Dim>, RowsSource
 // Leaves of ~16 points: a leaf scan is a short, branch-light loop.
 template <class T, int Dim>
 std::unique_ptr<KdTree<T, Dim>> build_tree(const RowsSource<T>& source) {
-  return std::make_unique<KdTree<T, Dim>>(source.cols, source, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  return std::make_unique<KdTree<T, Dim>>(source.cols, source,
+                                          nanoflann::KDTreeSingleIndexAdaptorParams(16));
 }
 
 template <class T, int Dim>
@@ -154,7 +155,8 @@ template <class T>
 struct NearestIndex<T>::Impl {
   Block<T> points;
   RowsSource<T> source;
-  explicit Impl(Block<T> p) : points(std::move(p)), source{points.data(), size_t(points.rows()), size_t(points.cols())} {}
+  explicit Impl(Block<T> p)
+      : points(std::move(p)), source{points.data(), size_t(points.rows()), size_t(points.cols())} {}
   virtual ~Impl() = default;
   virtual void query(const Block<T>& q, std::vector<int>& index, std::vector<T>* d) const = 0;
 };
@@ -163,7 +165,8 @@ namespace {
 template <class T, int Dim>
 struct TreeImpl final : NearestIndex<T>::Impl {
   std::unique_ptr<KdTree<T, Dim>> tree;
-  explicit TreeImpl(Block<T> p) : NearestIndex<T>::Impl(std::move(p)), tree(build_tree<T, Dim>(this->source)) {}
+  explicit TreeImpl(Block<T> p)
+      : NearestIndex<T>::Impl(std::move(p)), tree(build_tree<T, Dim>(this->source)) {}
   void query(const Block<T>& q, std::vector<int>& index, std::vector<T>* d) const override {
     query_tree<T, Dim>(*tree, q, index, d);
   }
@@ -174,10 +177,18 @@ template <class T>
 NearestIndex<T>::NearestIndex(Block<T> points) {
   check_shapes(points, points);
   switch (points.cols()) {
-    case 2: impl_ = std::make_unique<TreeImpl<T, 2>>(std::move(points)); break;
-    case 3: impl_ = std::make_unique<TreeImpl<T, 3>>(std::move(points)); break;
-    case 6: impl_ = std::make_unique<TreeImpl<T, 6>>(std::move(points)); break;
-    default: impl_ = std::make_unique<TreeImpl<T, -1>>(std::move(points)); break;
+    case 2:
+      impl_ = std::make_unique<TreeImpl<T, 2>>(std::move(points));
+      break;
+    case 3:
+      impl_ = std::make_unique<TreeImpl<T, 3>>(std::move(points));
+      break;
+    case 6:
+      impl_ = std::make_unique<TreeImpl<T, 6>>(std::move(points));
+      break;
+    default:
+      impl_ = std::make_unique<TreeImpl<T, -1>>(std::move(points));
+      break;
   }
 }
 
@@ -230,7 +241,7 @@ void nearest_brute_force(const Block<T>& queries, const Block<T>& points, std::v
 #define JSA_INSTANTIATE(T)                                                                        \
   template void nearest<T>(const Block<T>&, const Block<T>&, std::vector<int>&, std::vector<T>*); \
   template void nearest_brute_force<T>(const Block<T>&, const Block<T>&, std::vector<int>&,       \
-                                       std::vector<T>*);       \
+                                       std::vector<T>*);                                          \
   template class NearestIndex<T>;
 JSA_INSTANTIATE(float)
 JSA_INSTANTIATE(double)

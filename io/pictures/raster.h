@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "engine/block.h"
-#include "io/pictures/image.h"
 #include "io/geometry/mesh.h"
+#include "io/pictures/image.h"
 
 namespace jsa {
 

@@ -2,9 +2,9 @@
 
 #include <cmath>
 
+#include "io/geometry/vertex_normals.h"
 #include "io/pictures/plot.h"
 #include "io/pictures/raster.h"
-#include "io/geometry/vertex_normals.h"
 
 namespace jsa {
 
@@ -70,12 +70,13 @@ Image domain_coloured_views(const Block<double>& vertices, const Faces& faces,
   RenderOptions ro;
   ro.width = ro.height = size;
   std::vector<Image> views;
-  for (const Camera& c : three_views(vertices)) views.push_back(render_mesh(vertices, faces, colour, c, ro));
+  for (const Camera& c : three_views(vertices))
+    views.push_back(render_mesh(vertices, faces, colour, c, ro));
   return side_by_side(views);
 }
 
-Image textured_views(const Block<double>& vertices, const Faces& faces, const Block<double>& texture_uv,
-                     const Image& texture, int size) {
+Image textured_views(const Block<double>& vertices, const Faces& faces,
+                     const Block<double>& texture_uv, const Image& texture, int size) {
   RenderOptions ro;
   ro.width = ro.height = size;
   std::vector<Image> views;
@@ -84,9 +85,9 @@ Image textured_views(const Block<double>& vertices, const Faces& faces, const Bl
   return side_by_side(views);
 }
 
-Image uv_layout_picture(const Block<double>& vertices, const Faces& faces, const Block<double>& texture_uv,
-                        const Faces& uv_faces, const std::vector<int>& flipped, const std::vector<int>& torn,
-                        int size) {
+Image uv_layout_picture(const Block<double>& vertices, const Faces& faces,
+                        const Block<double>& texture_uv, const Faces& uv_faces,
+                        const std::vector<int>& flipped, const std::vector<int>& torn, int size) {
   std::vector<bool> is_torn(size_t(faces.rows()), false);
   for (int f : torn) is_torn[size_t(f)] = true;
   const Block<double> fn = face_normals(vertices, faces);
@@ -105,7 +106,8 @@ Image uv_layout_picture(const Block<double>& vertices, const Faces& faces, const
   for (int f : torn)
     for (int c = 0; c < 3; ++c) {
       const Index v = uv_faces(f, c);
-      fill_circle(image, {texture_uv(v, 0) * size, (1 - texture_uv(v, 1)) * size}, 1.5, colours::red());
+      fill_circle(image, {texture_uv(v, 0) * size, (1 - texture_uv(v, 1)) * size}, 1.5,
+                  colours::red());
     }
   return image;
 }

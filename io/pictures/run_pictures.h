@@ -9,8 +9,8 @@
 #pragma once
 #include <vector>
 
-#include "io/pictures/image.h"
 #include "io/geometry/mesh.h"
+#include "io/pictures/image.h"
 #include "model/tool/domain_mesh.h"
 #include "model/tool/loss_log.h"
 
@@ -23,12 +23,13 @@ Image domain_coloured_views(const Block<double>& vertices, const Faces& faces,
                             const Block<double>& texture_uv, int size = 384);
 // The same three views with each pixel coloured from `texture` at its
 // interpolated uv (V x 2, TextureFrame coordinates): texture transfer made visible.
-Image textured_views(const Block<double>& vertices, const Faces& faces, const Block<double>& texture_uv,
-                     const Image& texture, int size = 384);
+Image textured_views(const Block<double>& vertices, const Faces& faces,
+                     const Block<double>& texture_uv, const Image& texture, int size = 384);
 // flipped faces are outlined in red; torn faces (which span the cut, across the
 // whole layout) are left unfilled and marked by red dots at their corners.
 Image uv_layout_picture(const Block<double>& vertices, const Faces& faces,
                         const Block<double>& texture_uv, const Faces& uv_faces,
-                        const std::vector<int>& flipped, const std::vector<int>& torn, int size = 768);
+                        const std::vector<int>& flipped, const std::vector<int>& torn,
+                        int size = 768);
 
 }  // namespace jsa

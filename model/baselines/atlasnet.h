@@ -17,8 +17,8 @@
 #include "engine/adam.h"
 #include "io/geometry/mesh.h"
 #include "io/geometry/normalization.h"
-#include "model/tool/evaluate.h"
 #include "model/parametrize.h"
+#include "model/tool/evaluate.h"
 #include "model/tool/trainer.h"
 
 namespace jsa {

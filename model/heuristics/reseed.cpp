@@ -9,8 +9,10 @@ namespace jsa {
 
 ReseedReport reseed_flipped_means(Atlas<float>& atlas, const std::vector<Block<float>>& targets,
                                   const std::vector<int>& shapes, Rng& rng,
-                                  const std::vector<std::vector<float>*>& moments, int samples_per_mean) {
-  JSA_CHECK(!targets.empty() && targets.size() == shapes.size(), "reseed: one target block per shape");
+                                  const std::vector<std::vector<float>*>& moments,
+                                  int samples_per_mean) {
+  JSA_CHECK(!targets.empty() && targets.size() == shapes.size(),
+            "reseed: one target block per shape");
   JSA_CHECK(samples_per_mean > 0, "reseed: samples_per_mean must be positive");
   const int mu_index = atlas.domain.means();
   auto mu = atlas.params.value(mu_index);
@@ -33,7 +35,8 @@ ReseedReport reseed_flipped_means(Atlas<float>& atlas, const std::vector<Block<f
     const Block<double> target_points = targets[s].leftCols(3).cast<double>();
     nearest(points, target_points, nn);
     for (Index i = 0; i < K * S; ++i) {
-      const bool away = normals.row(i).dot(targets[s].row(nn[size_t(i)]).rightCols(3).cast<double>()) < 0;
+      const bool away =
+          normals.row(i).dot(targets[s].row(nn[size_t(i)]).rightCols(3).cast<double>()) < 0;
       back[size_t(i / S)] += away ? 1.0 : 0.0;
       if (s == 0) facing[size_t(i)] = away ? 0 : 1;
     }
@@ -68,7 +71,9 @@ ReseedReport reseed_flipped_means(Atlas<float>& atlas, const std::vector<Block<f
   for (size_t t = 0; t < d2.size(); ++t) cumulative[t] = (sum += d2[t]);
   for (Index k : flipped) {
     size_t t = size_t(rng.below(uint64_t(d2.size())));
-    if (sum > 0) t = size_t(std::upper_bound(cumulative.begin(), cumulative.end(), rng.uniform() * sum) - cumulative.begin());
+    if (sum > 0)
+      t = size_t(std::upper_bound(cumulative.begin(), cumulative.end(), rng.uniform() * sum) -
+                 cumulative.begin());
     t = std::min(t, d2.size() - 1);
     const Index from = good[size_t(nn[t])];
     for (int c = 0; c < 2; ++c) mu(k, c) = float(uv(from, c) + 0.5 * sigma * rng.normal());

@@ -75,9 +75,10 @@ Ellipsoid enclosing_ellipsoid(const Block<float>& pool) {
 }
 
 WrapReport wrap_initialize(Atlas<float>& atlas, const std::vector<Block<float>>& pools, int steps,
-                           Index points, double lr, Rng& rng, const std::function<bool()>& cancelled) {
-  JSA_CHECK(int(pools.size()) == atlas.shapes(), "wrap_initialize: " << pools.size() << " pools for "
-                                                                     << atlas.shapes() << " shapes");
+                           Index points, double lr, Rng& rng,
+                           const std::function<bool()>& cancelled) {
+  JSA_CHECK(int(pools.size()) == atlas.shapes(),
+            "wrap_initialize: " << pools.size() << " pools for " << atlas.shapes() << " shapes");
   WrapReport report;
   if (steps <= 0) return report;
   std::vector<Ellipsoid> ellipsoids;
@@ -104,9 +105,11 @@ WrapReport wrap_initialize(Atlas<float>& atlas, const std::vector<Block<float>>&
       }
       // |phi(u, v) - W(u, v)|^2 and |psi(W, alpha n_W) - (u, v)|^2, means over points.
       Var x = t.constant(uv);
-      Var phi_err = sub(t, atlas.phi.evaluate(t, atlas.params, x, false, atlas.phi_code(t, shape)).points,
-                        t.constant(wrap));
-      Var psi_err = sub(t, atlas.psi.evaluate(t, atlas.params, t.constant(wrap6), atlas.psi_code(t, shape)), x);
+      Var phi_err =
+          sub(t, atlas.phi.evaluate(t, atlas.params, x, false, atlas.phi_code(t, shape)).points,
+              t.constant(wrap));
+      Var psi_err = sub(
+          t, atlas.psi.evaluate(t, atlas.params, t.constant(wrap6), atlas.psi_code(t, shape)), x);
       Var phi_loss = scale(t, sum(t, square(t, phi_err)), 1.0f / float(points));
       Var psi_loss = scale(t, sum(t, square(t, psi_err)), 1.0f / float(points));
       phi_sq += t.scalar(phi_loss);

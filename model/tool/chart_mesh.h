@@ -19,16 +19,17 @@ namespace jsa {
 // psi([x, alpha n]) for each vertex of `mesh` (input frame, normalised with
 // `normalization`); vertex normals from the file or area-weighted from faces.
 // `shape`: which shape's chart psi_i in a collection (0 for a single shape).
-Block<double> chart_vertices(Atlas<float>& atlas, const Mesh& mesh, const Normalization& normalization,
-                             int shape = 0);
+Block<double> chart_vertices(Atlas<float>& atlas, const Mesh& mesh,
+                             const Normalization& normalization, int shape = 0);
 // psi_i at rows [x, alpha n] (unit frame), in batches.
 Block<double> chart_points(Atlas<float>& atlas, const Block<double>& x6, int shape = 0);
 
 struct SplitUv {
-  Block<double> uv;   // U x 2 domain coordinates: the V per-vertex ones, then 3 per split face
-  Faces uv_faces;     // F x 3 indices into uv
+  Block<double> uv;  // U x 2 domain coordinates: the V per-vertex ones, then 3 per split face
+  Faces uv_faces;    // F x 3 indices into uv
 };
 SplitUv split_torn(Atlas<float>& atlas, const Mesh& mesh, const Normalization& normalization,
-                   const Block<double>& vertex_uv, const std::vector<int>& torn_faces, int shape = 0);
+                   const Block<double>& vertex_uv, const std::vector<int>& torn_faces,
+                   int shape = 0);
 
 }  // namespace jsa

@@ -33,7 +33,8 @@ DomainMesh mesh_domain(const Atlas<float>& atlas, const DomainMeshOptions& o) {
   // P on the grid's nodes and at the means (for the relative level).
   Block<double> nodes(Index(nx) * ny, 2);
   for (int i = 0; i < nx; ++i)
-    for (int j = 0; j < ny; ++j) nodes.row(Index(i) * ny + j) << out.lo(0) + i * h, out.lo(1) + j * h;
+    for (int j = 0; j < ny; ++j)
+      nodes.row(Index(i) * ny + j) << out.lo(0) + i * h, out.lo(1) + j * h;
   const std::vector<double> p = atlas.domain.density(atlas.params, nodes);
   std::vector<double> at_means = atlas.domain.density(atlas.params, mu.cast<double>());
   std::nth_element(at_means.begin(), at_means.begin() + at_means.size() / 2, at_means.end());
@@ -62,7 +63,8 @@ DomainMesh mesh_domain(const Atlas<float>& atlas, const DomainMeshOptions& o) {
     if (id < 0) {
       const double t = (out.level - p[from]) / (p[to] - p[from]);
       id = int(verts.size());
-      verts.push_back(nodes.row(from) + std::clamp(t, 0.0, 1.0) * (nodes.row(to) - nodes.row(from)));
+      verts.push_back(nodes.row(from) +
+                      std::clamp(t, 0.0, 1.0) * (nodes.row(to) - nodes.row(from)));
     }
     return id;
   };
