@@ -87,8 +87,9 @@ std::vector<std::string> check_page(const std::string& name, const std::string& 
   std::string line;
   int number = 0;
   bool fenced = false;
+  // (?!...): "view.html" is not a citation of "view.h".
   static const std::regex path_re(
-      R"((\.\./|[A-Za-z0-9_])[A-Za-z0-9_./-]*\.(h|cpp|md)(#[A-Za-z0-9_-]+)?)");
+      R"((\.\./|[A-Za-z0-9_])[A-Za-z0-9_./-]*\.(h|cpp|md)(?![A-Za-z0-9_])(#[A-Za-z0-9_-]+)?)");
   static const std::regex cmd_re(R"((^|[^A-Za-z0-9_:-])jsatlas ([a-z][a-z-]*))");
   static const std::regex flag_re(R"((^|[ \[(])(--[a-z0-9][a-z0-9-]*))");
   while (std::getline(lines, line)) {
