@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <vector>
 
@@ -24,6 +25,7 @@
 #include "model/tool/checkpoint.h"
 #include "model/tool/fit_config.h"
 #include "model/tool/mpi/mpi_team.h"
+#include "model/tool/shape_input.h"
 
 namespace jsa::cli {
 namespace {
@@ -78,7 +80,11 @@ Trainer make_trainer(const FitOptions& o, const std::vector<Block<double>>& pool
       {"weights.code", "--w-code"},
       {"repulsion_tolerance", "--repulsion-tolerance"},
       {"wrap_steps", "--wrap"},
-      {"reseed_every", "--reseed"}};
+      {"reseed_every", "--reseed"},
+      {"template_steps", "--template-steps"},
+      {"template_share", "--template-share"},
+      {"chart_from", "--chart-from"},
+      {"code_lr_scale", "--code-lr-scale"}};
   try {
     return Trainer(o, pools, team);
   } catch (const InputError& e) {
@@ -154,31 +160,128 @@ void run_fit(FitArgs& a, Team& team) {
   // Each shape, a fixed pool of surface samples, and its unit frame (Sec. 4 data).
   // Over MPI each rank samples the pools of its own block of shapes; rank 0 also
   // reads the others' inputs (their frames for the checkpoint, their meshes for
-  // the outputs) but keeps no pool of theirs.
+  // the outputs) but keeps no pool of theirs. The pose step needs shape 0 (the
+  // reference) on every rank.
   const auto [block_first, block_last] = shape_block(int(inputs.size()), team.size(), team.rank());
+  const bool aligning = !resuming && inputs.size() > 1 && o.align_poses;
   std::vector<RunInput> shapes;
   std::vector<Block<double>> pools;
   std::vector<Normalization> frames;
   for (size_t i = 0; i < inputs.size(); ++i) {
     const bool mine = int(i) >= block_first && int(i) < block_last;
-    if (!mine && !root) {
+    pools.emplace_back(0, 6);
+    frames.emplace_back();
+    if (!mine && !root && !(i == 0 && aligning)) {
       shapes.emplace_back();
-      pools.emplace_back(0, 6);
-      frames.emplace_back();
       continue;
     }
     shapes.push_back(load_run_input(inputs[i], o.pool, o.seed + 1000 * i));
-    if (resuming) shapes.back().normalization = resumed.normalizations[i];
-    pools.push_back(mine ? shapes.back().pool : Block<double>(0, 6));
-    shapes.back().pool.resize(0, 6);
-    frames.push_back(shapes.back().normalization);
+    if (resuming) {
+      // The checkpoint's frame, but the rotation the pool has (none yet): the
+      // pose step below turns the pool into the checkpoint's rotation.
+      const Eigen::Matrix3d drawn = shapes.back().normalization.rotation;
+      shapes.back().normalization = resumed.normalizations[i];
+      shapes.back().normalization.rotation = drawn;
+    }
     for (const std::string& w : shapes.back().mesh.warnings)
       if (mine && !(a.quiet && root)) std::cerr << "warning: " << inputs[i] << ": " << w << "\n";
   }
   o.atlas.shapes = int(inputs.size());
+  // The pose step (io/geometry/rigid_align.h): every shape turned into the
+  // first one's pose; a resumed run takes the rotations of its checkpoint.
+  // Deterministic, so every rank computes the rotations of its own shapes and
+  // rank 0 those of all (for rotations.json and the frames it saves); the check
+  // below makes sure they agree.
+  std::vector<RigidAlignment> poses(inputs.size());
+  if (resuming) {
+    for (size_t i = 0; i < inputs.size(); ++i) {
+      set_rotation(shapes[i], resumed.normalizations[i].rotation);
+      poses[i].rotation = resumed.normalizations[i].rotation;
+    }
+  } else if (aligning) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (root) {
+      poses = align_to_first(shapes);
+    } else {
+      // align_to_first, for this rank's block only.
+      for (int i = std::max(1, block_first); i < block_last; ++i) {
+        set_rotation(shapes[size_t(i)], Eigen::Matrix3d::Identity());
+        poses[size_t(i)] =
+            rigid_align(shapes[size_t(i)].pool.leftCols(3), shapes[0].pool.leftCols(3));
+        set_rotation(shapes[size_t(i)], poses[size_t(i)].rotation);
+      }
+    }
+    if (many) {
+      // Each rank's rotations of its own shapes, summed: rank 0 must find its own.
+      std::vector<double> owned(9 * inputs.size(), 0.0);
+      for (int i = block_first; i < block_last; ++i)
+        for (int k = 0; k < 9; ++k)
+          owned[size_t(9 * i + k)] = poses[size_t(i)].rotation(k / 3, k % 3);
+      team.sum_in_rank_order(owned.data(), owned.size());
+      if (root)
+        for (size_t i = 0; i < inputs.size(); ++i)
+          for (int k = 0; k < 9; ++k)
+            if (owned[9 * i + size_t(k)] != poses[i].rotation(k / 3, k % 3))
+              throw std::runtime_error("fit: the MPI ranks disagree on the pose of shape " +
+                                       std::to_string(i) + " (" + inputs[i] + ")");
+    }
+    if (!a.quiet) {
+      std::cerr << "fit: poses aligned to shape 0 in "
+                << format_duration(
+                       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count())
+                << ":";
+      for (size_t i = 1; i < poses.size(); ++i)
+        std::fprintf(stderr, " %zu: %.1f deg;", i, poses[i].angle_degrees());
+      std::cerr << "\n";
+    }
+  }
+  for (size_t i = 0; i < inputs.size(); ++i) {
+    const bool mine = int(i) >= block_first && int(i) < block_last;
+    if (mine) pools[i] = shapes[i].pool;
+    frames[i] = shapes[i].normalization;
+    shapes[i].pool.resize(0, 6);                 // the trainer keeps its own copy
+    if (!mine && !root) shapes[i] = RunInput{};  // shape 0, read for the pose step only
+  }
   if (root) fs::create_directories(a.out_dir);
   const std::string dir = a.out_dir;
+  auto rotations_json = [&]() {
+    nlohmann::json r = nlohmann::json::array();
+    for (size_t i = 0; i < inputs.size(); ++i) {
+      nlohmann::json m = nlohmann::json::array();
+      for (int row = 0; row < 3; ++row)
+        m.push_back(
+            {poses[i].rotation(row, 0), poses[i].rotation(row, 1), poses[i].rotation(row, 2)});
+      nlohmann::json e = {
+          {"input", inputs[i]}, {"rotation", m}, {"angle_degrees", poses[i].angle_degrees()}};
+      if (i > 0 && !resuming && o.align_poses) {
+        e["chamfer"] = poses[i].chamfer;
+        e["runner_up_chamfer"] = poses[i].runner_up;
+        e["candidates"] = poses[i].candidates;
+        e["input_pose_chamfer"] = poses[i].input_chamfer;
+        e["kept_input_pose"] = poses[i].kept_input;
+      }
+      r.push_back(e);
+    }
+    return r;
+  };
+  if (root && inputs.size() > 1) {
+    const nlohmann::json r = {{"convention",
+                               "unit-frame rows: x_unit = ((x_input - center) / scale) * rotation; "
+                               "shape 0 is the reference"},
+                              {"shapes", rotations_json()}};
+    write_file_atomically(dir + "/rotations.json",
+                          [&](std::ostream& out) { out << r.dump(2) << "\n"; });
+  }
 
+  // The template start trains shape 0 alone, which a data-parallel run cannot
+  // share out: its automatic length (-1, the default for collections) is 0 on
+  // more than one rank; an explicit length is refused by the trainer.
+  if (many && o.template_steps < 0) {
+    o.template_steps = 0;
+    if (!a.quiet)
+      std::cerr << "fit: no template start with " << team.size()
+                << " MPI ranks (--template-steps 0)\n";
+  }
   Trainer trainer = make_trainer(o, pools, &team);
   LossLog log;
   if (resuming) {
@@ -203,8 +306,9 @@ void run_fit(FitArgs& a, Team& team) {
     write_file_atomically(dir + "/config.json", [&](std::ostream& out) {
       out << "{\n\"inputs\": [";
       for (size_t i = 0; i < inputs.size(); ++i) out << (i ? ", " : "") << json_quote(inputs[i]);
-      out << "],\n\"settings\": " << fit_options_to_json(o)
-          << ",\n\"report\": {\"iteration\": " << trainer.iteration()
+      out << "],\n\"settings\": " << fit_options_to_json(o);
+      if (inputs.size() > 1) out << ",\n\"rotations\": " << rotations_json().dump();
+      out << ",\n\"report\": {\"iteration\": " << trainer.iteration()
           << ", \"faults\": " << trainer.faults() << ", \"fault_actions\": [";
       for (size_t i = 0; i < trainer.fault_log().size(); ++i)
         out << (i ? ", " : "") << json_quote(describe(trainer.fault_log()[i]));
@@ -246,6 +350,41 @@ void run_fit(FitArgs& a, Team& team) {
       std::cerr << "fit: phi and psi wrapped around the shape's ellipsoid (" << o.wrap_steps
                 << " steps, " << format_duration(wrap_seconds) << "; RMS error phi " << w.phi_error
                 << ", psi " << w.psi_error << ")\n";
+  }
+  const bool collection = inputs.size() > 1;
+  if (!resuming && collection &&
+      (o.template_steps > 0 || (o.template_steps < 0 && o.template_share > 0))) {
+    // The template start (FitOptions::template_steps): shape 0 alone, then its
+    // codes copied to every shape. Under --minutes its length is the share of
+    // the budget, timed on its own steps (a fifth of a joint step for N = 4).
+    const auto t0 = clock::now();
+    auto cancelled = [] { return g_signal != 0; };
+    int64_t steps = o.template_steps;
+    if (steps < 0 && a.minutes > 0) {
+      const int64_t warm = 5, timed = 20;
+      trainer.train_template(warm, cancelled);
+      const auto p0 = clock::now();
+      trainer.train_template(timed, cancelled);
+      const double per = std::chrono::duration<double>(clock::now() - p0).count() / double(timed);
+      steps = std::max<int64_t>(warm + timed, int64_t(o.template_share * a.minutes * 60.0 / per));
+    } else if (steps < 0) {
+      steps = Trainer::template_steps_for(o, o.iterations, int(inputs.size()));
+    }
+    trainer.train_template(steps - trainer.template_done(), cancelled);
+    if (g_signal) {
+      std::cerr << "fit: interrupted while fitting the template (before training); no checkpoint "
+                   "written\n";
+      throw ExitCode{130};
+    }
+    trainer.finish_template();
+    o.template_steps = trainer.template_done();
+    trainer.set_template_steps(o.template_steps);
+    const double seconds = std::chrono::duration<double>(clock::now() - t0).count();
+    wrap_seconds += seconds;
+    if (!a.quiet)
+      std::cerr << "fit: template start: shape 0 alone for " << o.template_steps << " steps ("
+                << format_duration(seconds) << ", L " << trainer.last().total
+                << "), its codes copied to every shape\n";
   }
   if (a.inject_fault_at >= 0) trainer.inject_faults(a.inject_fault_at, 1);
   const auto start = clock::now();
@@ -373,6 +512,10 @@ const CLI::Validator kFinite(
 void add_fit(CLI::App& app) {
   auto a = std::make_shared<FitArgs>();
   FitOptions& o = a->options;
+  // Collections start from one shape's atlas (the template start), 30% of the
+  // run: measured on the SHREC ants and teddies (docs/collections.md).
+  o.template_steps = -1;
+  o.template_share = 0.3;
   CLI::App* c = app.add_subcommand(
       "fit", "Learn the atlas of a shape: domain P, parametrization phi, chart psi");
   c->add_option("inputs", a->inputs,
@@ -472,7 +615,8 @@ void add_fit(CLI::App& app) {
       "--preset", a->preset,
       "paper: the paper's method at its sizes: M = K = 10^4, 5 x 256 ReLU MLPs, alpha 0.01, "
       "lambda_cycle 1, and none of the heuristics beyond the paper (no orientation mirror, wrap, "
-      "reseed or dense surface; slow on a laptop; these win over the same settings' flags)");
+      "reseed, dense surface, pose alignment or template start; slow on a laptop; these win over "
+      "the same settings' flags)");
   c->add_option("--pool", o.pool, "Surface samples drawn once from the input")
       ->capture_default_str()
       ->check(CLI::Range(Index(100), Index(10000000)));
@@ -506,6 +650,32 @@ void add_fit(CLI::App& app) {
                 "(0: random start, as the paper; see model/heuristics/wrap.h)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1000000));
+  c->add_option("--code-lr-scale", o.code_lr_scale,
+                "Collections: learning rate of the latent codes as a multiple of the networks'")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-3, 1e3))
+      ->check(kFinite);
+  c->add_option("--chart-from", o.chart_from,
+                "Staged objective: phi and P alone (no psi, L_2D, L_cycle) until this fraction of "
+                "--iters, then the full method (0: full from the start)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0))
+      ->check(kFinite);
+  c->add_option("--template-steps", o.template_steps,
+                "Collections: steps fitting shape 0 alone before the joint training, then its "
+                "codes copied to every shape (-1: from --template-share)")
+      ->capture_default_str()
+      ->check(CLI::Range(int64_t(-1), int64_t(100000000)));
+  c->add_option("--template-share", o.template_share,
+                "Collections, with --template-steps -1: share of the run's time (or cost) spent on "
+                "the template start")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.95))
+      ->check(kFinite);
+  c->add_flag("--align,!--no-align", o.align_poses,
+              "Collections: turn every shape into the pose of the first (principal axes, ICP, "
+              "lowest Chamfer) before fitting; rotations.json lists them")
+      ->capture_default_str();
   c->add_option("--batch-shapes", o.batch_shapes,
                 "Collections: shapes per iteration, a seeded random subset (0: all); the loss is "
                 "scaled by N/B")

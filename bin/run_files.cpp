@@ -104,7 +104,7 @@ void write_domain_mesh(Atlas<float>& atlas, const Normalization& normalization,
   Block<double> points, normals;
   evaluate_surface(atlas, dm.uv, points, normals, shape);
   out.vertices = normalization.from_unit(points);
-  out.normals = normals;
+  out.normals = normalization.normals_from_unit(normals);
   out.faces = dm.faces;
   // The domain's grid is one injective chart by construction; its UVs are the
   // shared layout (the TextureFrame inset by the padding), the same on every shape.

@@ -153,7 +153,8 @@ void run_view(const ViewArgs& a) {
       // Every vertex of shape i to every other shape j, exactly as `jsatlas
       // correspond --from i --to j --vertices ... --snap` does: q = phi_j(psi_i(p)),
       // then the nearest vertex of j's input, in j's own frame.
-      const Block<double> vertex_normals = vertex_normals_of(m);
+      // In the unit frame, as the points: turned by the shape's pose (rotations.json).
+      const Block<double> vertex_normals = f.normals_to_unit(vertex_normals_of(m));
       s.correspondence.resize(n);
       s.keypoint_error.resize(n);
       for (size_t j = 0; j < n; ++j) {

@@ -39,3 +39,24 @@ TEST_CASE("a shape without extent is rejected, naming its source", "[io][normali
   }
   CHECK_THROWS_AS(jsa::normalization_of(jsa::Block<double>(0, 3)), jsa::InputError);
 }
+
+TEST_CASE("a rotation turns points and normals, and from_unit undoes it", "[io][normalization]") {
+  jsa::Rng rng(11);
+  jsa::Block<double> points(50, 3), normals(50, 3);
+  for (jsa::Index i = 0; i < points.rows(); ++i) {
+    points.row(i) << rng.normal(), rng.normal() + 4, rng.normal();
+    normals.row(i) << rng.normal(), rng.normal(), rng.normal();
+  }
+  jsa::Normalization n = jsa::normalization_of(points);
+  const jsa::Block<double> plain = n.to_unit(points);
+  n.rotation = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const jsa::Block<double> unit = n.to_unit(points);
+  // The rotation comes after centring and scaling: norms in the unit frame are kept.
+  CHECK((unit.rowwise().norm() - plain.rowwise().norm()).cwiseAbs().maxCoeff() < 1e-12);
+  CHECK((unit - plain * n.rotation).cwiseAbs().maxCoeff() < 1e-12);
+  CHECK((n.from_unit(unit) - points).cwiseAbs().maxCoeff() < 1e-12);
+  CHECK((n.normals_from_unit(n.normals_to_unit(normals)) - normals).cwiseAbs().maxCoeff() < 1e-12);
+  // A normal keeps its angle to the surface's points: dot products are unchanged.
+  CHECK((n.normals_to_unit(normals).row(3).dot(unit.row(3)) - normals.row(3).dot(plain.row(3))) ==
+        Approx(0).margin(1e-12));
+}

@@ -259,3 +259,88 @@ TEST_CASE("trainer: dense L_6D is seeded and learns the unit sphere", "[trainer]
   CHECK(radial < 0.05);
   CHECK(facing > 0.9);
 }
+
+namespace {
+
+// Row r of the parameter block `name` (one latent code per row).
+std::vector<float> code_row(Trainer& t, const char* name, Index r) {
+  const auto& e = t.atlas().params.entry(t.atlas().params.find(name));
+  const float* v = t.atlas().params.values().data() + e.offset + r * e.cols;
+  return std::vector<float>(v, v + e.cols);
+}
+
+std::vector<Block<double>> two_spheres() { return {sphere_pool(4000, 1), sphere_pool(4000, 2)}; }
+
+}  // namespace
+
+TEST_CASE("trainer: the template start fits shape 0 alone, then every shape starts from its codes",
+          "[trainer]") {
+  FitOptions o = small_options();
+  o.iterations = 10;
+  o.template_steps = 30;
+  o.threads = 1;
+  Trainer t(o, two_spheres());
+  const std::vector<float> start = code_row(t, "codes.phi", 0);
+  t.train_template(30);
+  CHECK(t.template_done() == 30);
+  CHECK(t.iteration() == 0);
+  CHECK(code_row(t, "codes.phi", 0) != start);  // shape 0's code was trained
+  CHECK(code_row(t, "codes.phi", 1) != code_row(t, "codes.phi", 0));
+  t.finish_template();
+  CHECK(code_row(t, "codes.phi", 1) == code_row(t, "codes.phi", 0));
+  CHECK(code_row(t, "codes.psi", 1) == code_row(t, "codes.psi", 0));
+  t.step();
+  CHECK(t.iteration() == 1);
+  CHECK(t.template_done() == 30);  // not run again
+
+  // step() runs the template itself when it has not run: the same trajectory.
+  Trainer u(o, two_spheres());
+  u.step();
+  CHECK(u.template_done() == 30);
+  CHECK(u.atlas().params.values() == t.atlas().params.values());
+
+  // The state carries the template's progress.
+  Trainer r(o, two_spheres());
+  r.load_state(u.save_state(), "state");
+  CHECK(r.template_done() == 30);
+  r.step();
+  u.step();
+  CHECK(r.last().total == u.last().total);
+}
+
+TEST_CASE("trainer: code_lr_scale scales the codes' Adam step and nothing else", "[trainer]") {
+  FitOptions o = small_options();
+  o.threads = 1;
+  FitOptions half = o;
+  half.code_lr_scale = 0.5;
+  Trainer a(o, two_spheres()), b(half, two_spheres());
+  const std::vector<float> before = code_row(a, "codes.phi", 1);
+  REQUIRE(code_row(b, "codes.phi", 1) == before);
+  a.step();
+  b.step();
+  CHECK(a.last().total == b.last().total);  // the same first loss: the same start and draws
+  const std::vector<float> da = code_row(a, "codes.phi", 1), db = code_row(b, "codes.phi", 1);
+  double moved = 0;
+  for (size_t k = 0; k < before.size(); ++k) {
+    moved += std::abs(da[k] - before[k]);
+    REQUIRE(double(db[k] - before[k]) == Approx(0.5 * double(da[k] - before[k])).margin(1e-7));
+  }
+  CHECK(moved > 0);
+  const auto& e = a.atlas().params.entry(a.atlas().params.find("phi.w0"));
+  CHECK(a.atlas().params.values()[e.offset] == b.atlas().params.values()[e.offset]);
+}
+
+TEST_CASE("trainer: chart_from trains phi and P alone until that fraction of the run",
+          "[trainer]") {
+  FitOptions o = small_options();
+  o.iterations = 10;
+  o.chart_from = 0.5;
+  Trainer t(o, sphere_pool(4000, 1));
+  for (int i = 0; i < 5; ++i) {
+    t.step();
+    CHECK(t.last().chart == 0);
+    CHECK(t.last().cycle_2d == 0);
+  }
+  t.step();  // from iteration 5: the full method
+  CHECK(t.last().chart > 0);
+}

@@ -9,12 +9,22 @@ namespace jsa {
 
 Block<double> Normalization::to_unit(const Block<double>& points) const {
   JSA_CHECK(points.cols() == 3, "points must be N x 3, got N x " << points.cols());
-  return (points.rowwise() - center) / scale;
+  return ((points.rowwise() - center) / scale) * rotation;
 }
 
 Block<double> Normalization::from_unit(const Block<double>& points) const {
   JSA_CHECK(points.cols() == 3, "points must be N x 3, got N x " << points.cols());
-  return (points * scale).rowwise() + center;
+  return ((points * rotation.transpose()) * scale).rowwise() + center;
+}
+
+Block<double> Normalization::normals_to_unit(const Block<double>& normals) const {
+  JSA_CHECK(normals.cols() == 3, "normals must be N x 3, got N x " << normals.cols());
+  return normals * rotation;
+}
+
+Block<double> Normalization::normals_from_unit(const Block<double>& normals) const {
+  JSA_CHECK(normals.cols() == 3, "normals must be N x 3, got N x " << normals.cols());
+  return normals * rotation.transpose();
 }
 
 Normalization normalization_of(const Block<double>& points, const std::string& source) {

@@ -12,7 +12,8 @@ Block<double> chart_input(const Atlas<float>& atlas, const Mesh& mesh,
       mesh.has_normals() ? mesh.normals : area_weighted_vertex_normals(mesh.vertices, mesh.faces);
   Block<double> in(mesh.vertices.rows(), 6);
   in.leftCols(3) = normalization.to_unit(mesh.vertices);
-  in.rightCols(3) = atlas.options().alpha * normals.rowwise().normalized();
+  in.rightCols(3) =
+      atlas.options().alpha * normalization.normals_to_unit(normals).rowwise().normalized();
   return in;
 }
 

@@ -49,8 +49,14 @@ void write_checkpoint(const std::string& path, const std::vector<std::string>& i
   JSA_CHECK(inputs.size() == normalizations.size() && !inputs.empty(),
             "one normalisation per input");
   json frames = json::array();
-  for (const Normalization& n : normalizations)
-    frames.push_back(json{{"center", {n.center(0), n.center(1), n.center(2)}}, {"scale", n.scale}});
+  for (const Normalization& n : normalizations) {
+    json rotation = json::array();  // rows, as io/geometry/normalization.h applies it
+    for (int r = 0; r < 3; ++r)
+      rotation.push_back({n.rotation(r, 0), n.rotation(r, 1), n.rotation(r, 2)});
+    frames.push_back(json{{"center", {n.center(0), n.center(1), n.center(2)}},
+                          {"scale", n.scale},
+                          {"rotation", rotation}});
+  }
   const TrainerState state = trainer.save_state();
   const std::map<std::string, std::string> payload = {
       {"inputs", json(inputs).dump()},  {"settings", fit_options_to_json(options, -1)},
@@ -145,6 +151,23 @@ CheckpointContents read_checkpoint(const std::string& path) {
       n.scale = f.at("scale").get<double>();
       if (!(n.scale > 0) || !std::isfinite(n.scale) || !n.center.allFinite())
         throw std::runtime_error("bad frame");
+      // The shape's pose (collections, io/geometry/rigid_align.h); a frame
+      // without one (written before the pose step) is in the input's pose.
+      if (f.contains("rotation")) {
+        const json& rows = f.at("rotation");
+        if (!rows.is_array() || rows.size() != 3) throw std::runtime_error("a rotation is 3 x 3");
+        for (int r = 0; r < 3; ++r) {
+          if (!rows[size_t(r)].is_array() || rows[size_t(r)].size() != 3)
+            throw std::runtime_error("a rotation is 3 x 3");
+          for (int k = 0; k < 3; ++k) n.rotation(r, k) = rows[size_t(r)][size_t(k)].get<double>();
+        }
+        const bool proper = n.rotation.allFinite() &&
+                            (n.rotation * n.rotation.transpose() - Eigen::Matrix3d::Identity())
+                                    .cwiseAbs()
+                                    .maxCoeff() < 1e-6 &&
+                            n.rotation.determinant() > 0;
+        if (!proper) throw std::runtime_error("bad rotation");
+      }
       c.normalizations.push_back(n);
     }
   } catch (const std::exception& e) {

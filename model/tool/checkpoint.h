@@ -10,7 +10,8 @@
 //   u64             64-bit FNV-1a checksum of every preceding byte
 //
 // Sections (all required): "inputs" (JSON list of what was fitted), "settings"
-// (fit_options_to_json), "normalisation" (JSON, one frame per shape),
+// (fit_options_to_json), "normalisation" (JSON, one frame per shape: centre,
+// scale and rotation, rows; a frame without a rotation reads as the identity),
 // "parameters", "optimiser", "rng", "iteration" (the Trainer's state, see
 // TrainerState in model/tool/trainer.h). Written atomically (temp, fsync, rename); a
 // truncated or corrupted file is rejected before anything is loaded.

@@ -1,5 +1,7 @@
 #include "model/tool/correspondence.h"
 
+#include <limits>
+
 #include "io/geometry/nearest.h"
 #include "io/geometry/vertex_normals.h"
 #include "model/tool/chart_mesh.h"
@@ -13,6 +15,67 @@ Block<double> vertex_normals_of(const Mesh& mesh) {
   return area_weighted_vertex_normals(mesh.vertices, mesh.faces);
 }
 
+namespace {
+
+// phi_I at uv with its Jacobian columns (unit frame).
+void surface_with_jacobian(Atlas<float>& atlas, const Block<double>& uv, int shape,
+                           Block<double>& q, Block<double>& du, Block<double>& dv) {
+  q.resize(uv.rows(), 3);
+  du.resize(uv.rows(), 3);
+  dv.resize(uv.rows(), 3);
+  Tape<float> t;
+  const Index batch = 8192;
+  for (Index b = 0; b < uv.rows(); b += batch) {
+    const Index n = std::min(batch, uv.rows() - b);
+    t.clear();
+    SurfacePoints s =
+        atlas.phi.evaluate(t, atlas.params, t.constant(uv.middleRows(b, n).cast<float>()), true,
+                           atlas.phi_code(t, shape));
+    q.middleRows(b, n) = t.value(s.points).cast<double>();
+    du.middleRows(b, n) = t.value(s.du).cast<double>();
+    dv.middleRows(b, n) = t.value(s.dv).cast<double>();
+  }
+}
+
+// Minimises |phi_I(u) - p|^2 over u from the start uv: Levenberg-Marquardt per
+// point, (J^T J + lambda diag(J^T J)) du = J^T (p - phi(u)); a step that does not
+// lower the residual is undone and lambda grows tenfold, else lambda shrinks.
+void refine_inverse(Atlas<float>& atlas, int shape, const Block<double>& p, int steps,
+                    Block<double>& uv) {
+  const Index n = p.rows();
+  std::vector<double> lambda(size_t(n), 1e-3),
+      best(size_t(n), std::numeric_limits<double>::infinity());
+  Block<double> best_uv = uv, q, du, dv;
+  for (int k = 0; k <= steps; ++k) {
+    surface_with_jacobian(atlas, uv, shape, q, du, dv);
+    for (Index i = 0; i < n; ++i) {
+      const Eigen::RowVector3d r = p.row(i) - q.row(i);
+      const double e = r.squaredNorm();
+      if (e <= best[size_t(i)]) {
+        best[size_t(i)] = e;
+        best_uv.row(i) = uv.row(i);
+        lambda[size_t(i)] = std::max(1e-6, lambda[size_t(i)] * 0.3);
+      } else {
+        lambda[size_t(i)] *= 10;
+        uv.row(i) = best_uv.row(i);
+        continue;  // the Jacobian below belongs to the rejected point: step again next round
+      }
+      if (k == steps) continue;
+      const double a = du.row(i).squaredNorm(), b = du.row(i).dot(dv.row(i)),
+                   c = dv.row(i).squaredNorm();
+      const double l = lambda[size_t(i)];
+      const double a2 = a * (1 + l), c2 = c * (1 + l), det = a2 * c2 - b * b;
+      if (!(det > 0)) continue;
+      const double gu = du.row(i).dot(r), gv = dv.row(i).dot(r);
+      uv(i, 0) += (c2 * gu - b * gv) / det;
+      uv(i, 1) += (a2 * gv - b * gu) / det;
+    }
+  }
+  uv = best_uv;
+}
+
+}  // namespace
+
 Block<double> correspond(Atlas<float>& atlas, int from, int to, const Block<double>& p_unit,
                          const Block<double>& normals, const CorrespondenceOptions& o) {
   Block<double> uv;
@@ -22,6 +85,7 @@ Block<double> correspond(Atlas<float>& atlas, int from, int to, const Block<doub
     x6.leftCols(3) = p_unit;
     x6.rightCols(3) = atlas.options().alpha * normals.rowwise().normalized();
     uv = chart_points(atlas, x6, from);
+    if (o.refine_steps > 0) refine_inverse(atlas, from, p_unit, o.refine_steps, uv);
   } else {
     // The nearest-sample rule: argmin over samples x ~ P of |phi_I(x) - p|.
     Rng rng(o.seed, 20);
@@ -69,7 +133,7 @@ KeypointError keypoint_error(const CorrespondenceMap& map, const std::vector<Mes
   double total = 0;
   for (size_t i = 0; i < n; ++i) {
     const Block<double> unit = frames[i].to_unit(meshes[i].vertices);
-    const Block<double> normals = vertex_normals_of(meshes[i]);
+    const Block<double> normals = frames[i].normals_to_unit(vertex_normals_of(meshes[i]));
     Block<double> p(Index(k), 3), pn(Index(k), 3);
     for (size_t m = 0; m < k; ++m) {
       p.row(Index(m)) = unit.row(keypoints[i][m]);

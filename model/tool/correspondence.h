@@ -17,6 +17,11 @@ struct CorrespondenceOptions {
   bool use_chart = true;          // false: the nearest-sample rule (no psi)
   Index nearest_samples = 20000;  // samples of P for the nearest-sample rule
   uint64_t seed = 0;
+  // Chart rule: damped Gauss-Newton steps that move u = psi_I(p) to the nearest
+  // point of phi_I(u) to p before mapping by phi_J (0: psi alone, the paper's rule).
+  // psi is trained to invert phi; these steps finish the inversion it has not
+  // reached (beyond the paper; docs/collections.md).
+  int refine_steps = 0;
 };
 
 // p_unit: N x 3 points and n: N x 3 unit normals on shape `from`, in its unit

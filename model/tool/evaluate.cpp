@@ -20,10 +20,12 @@ Evaluation evaluate_points(const Block<double>& pp, const Block<double>& pn, con
   SurfaceSamples b = sample_surface(shape, o.samples, rng_b);
   const Block<double> ap = normalization.to_unit(a.points), bp = normalization.to_unit(b.points);
   Evaluation e;
-  e.fit = surface_metrics(pp, pn, ap, a.normals);
-  e.floor = surface_metrics(bp, b.normals, ap, a.normals);
-  e.fit_emd = emd_metrics(pp, pn, ap, a.normals);
-  e.floor_emd = emd_metrics(bp, b.normals, ap, a.normals);
+  const Block<double> an = normalization.normals_to_unit(a.normals),
+                      bn = normalization.normals_to_unit(b.normals);
+  e.fit = surface_metrics(pp, pn, ap, an);
+  e.floor = surface_metrics(bp, bn, ap, an);
+  e.fit_emd = emd_metrics(pp, pn, ap, an);
+  e.floor_emd = emd_metrics(bp, bn, ap, an);
   return e;
 }
 

@@ -76,6 +76,11 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["wrap_steps"] = o.wrap_steps;
   j["reseed_every"] = o.reseed_every;
   j["dense_surface"] = o.dense_surface;
+  j["template_steps"] = o.template_steps;
+  j["align_poses"] = o.align_poses;
+  j["template_share"] = o.template_share;
+  j["chart_from"] = o.chart_from;
+  j["code_lr_scale"] = o.code_lr_scale;
   j["pool"] = o.pool;
   j["threads"] = o.threads;
   return j.dump(indent);
@@ -146,6 +151,22 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (j.contains("reseed_every")) field(j, "", "reseed_every", o.reseed_every);
   o.dense_surface = false;
   if (j.contains("dense_surface")) field(j, "", "dense_surface", o.dense_surface);
+  o.template_steps = 0;
+  o.template_share = 0;
+  o.align_poses = false;  // later addition: runs before it were not aligned
+  if (j.contains("align_poses")) field(j, "", "align_poses", o.align_poses);
+  if (j.contains("template_steps")) field(j, "", "template_steps", o.template_steps);
+  if (j.contains("template_share")) field(j, "", "template_share", o.template_share);
+  o.code_lr_scale = 1;
+  if (j.contains("code_lr_scale")) field(j, "", "code_lr_scale", o.code_lr_scale);
+  if (!(o.code_lr_scale > 0) || !std::isfinite(o.code_lr_scale))
+    throw InputError(what + ": code_lr_scale must be positive");
+  o.chart_from = 0;
+  if (j.contains("chart_from")) field(j, "", "chart_from", o.chart_from);
+  if (!(o.chart_from >= 0 && o.chart_from <= 1))
+    throw InputError(what + ": chart_from must be in [0, 1]");
+  if (o.template_steps < -1 || !(o.template_share >= 0 && o.template_share < 1))
+    throw InputError(what + ": template_steps must be >= -1 and template_share in [0, 1)");
   field(j, "", "pool", o.pool);
   field(j, "", "threads", o.threads);
   if (o.atlas.gaussians <= 0 || o.atlas.width <= 0 || o.atlas.hidden_layers < 0 || o.points <= 0 ||

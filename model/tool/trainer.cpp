@@ -42,6 +42,11 @@ static void validate(const FitOptions& o) {
           "orient_every, reseed_every and wrap_steps must be >= 0");
   require(o.max_faults >= 0, "max_faults must be >= 0");
   require(o.fault_lr_factor > 0 && o.fault_lr_factor <= 1, "fault_lr_factor must be in (0, 1]");
+  require(o.template_steps >= -1, "template_steps must be >= -1");
+  require(o.template_share >= 0 && o.template_share < 1, "template_share must be in [0, 1)");
+  require(o.chart_from >= 0 && o.chart_from <= 1, "chart_from must be in [0, 1]");
+  require(o.code_lr_scale > 0 && std::isfinite(o.code_lr_scale),
+          "code_lr_scale must be positive and finite");
 }
 
 Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools, Team* team)
@@ -57,6 +62,10 @@ Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools, T
     throw InputError("wrap_steps is not supported with more than one MPI rank");
   if (ranks > 1 && o.reseed_every > 0)
     throw InputError("reseed_every is not supported with more than one MPI rank");
+  // The template start trains shape 0 alone: one rank would work while the
+  // others wait, so a data-parallel run starts all shapes jointly.
+  if (ranks > 1 && template_steps_for(o, o.iterations, n) > 0)
+    throw InputError("template_steps is not supported with more than one MPI rank");
   std::tie(first_shape_, last_shape_) = jsa::shape_block(n, ranks, team ? team->rank() : 0);
   for (int i = 0; i < n; ++i) {
     const Block<double>& pool = pools[size_t(i)];
@@ -91,7 +100,8 @@ Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools, T
 
 std::string describe(const FaultRecovery& f) {
   std::ostringstream s;
-  s << "NaN/Inf in the step from iteration " << f.iteration << "; restored the state of iteration "
+  const char* what = f.template_step ? "template step " : "iteration ";
+  s << "NaN/Inf in the step from " << what << f.iteration << "; restored the state of " << what
     << f.restored << " (parameters, Adam, RNG, counter), learning-rate scale now " << f.lr_scale;
   return s.str();
 }
@@ -109,6 +119,7 @@ void Trainer::take_snapshot(const std::array<uint64_t, 4>& rng_state) {
   good_.v = adam_.second_moment();
   good_.adam_steps = adam_.steps();
   good_.iteration = iteration_;
+  good_.template_done = template_done_;
   good_.rng = rng_state;
 }
 
@@ -118,6 +129,7 @@ void Trainer::restore_snapshot() {
   adam_.second_moment() = good_.v;
   adam_.set_steps(good_.adam_steps);
   iteration_ = good_.iteration;
+  template_done_ = good_.template_done;
   rng_.set_state(good_.rng);
 }
 
@@ -134,10 +146,17 @@ WrapReport Trainer::wrap(const std::function<bool()>& cancelled) {
 void Trainer::step() {
   const auto start = std::chrono::steady_clock::now();
   if (iteration_ == 0 && !wrapped_) wrap();
+  const int n = int(pools_.size()), b = int(batch_.size());
+  if (iteration_ == 0 && n > 1 && !template_finished_) {
+    const int64_t want = template_steps_for(options_, options_.iterations, n);
+    if (want > 0) {
+      if (template_done_ < want) train_template(want - template_done_);
+      finish_template();
+    }
+  }
   // The state this step starts from: a snapshot taken after it is checked
   // finite must replay the same draws.
   const std::array<uint64_t, 4> rng_at_start = rng_.state();
-  const int n = int(pools_.size()), b = int(batch_.size());
   if (b < n) {
     // A uniform subset of B shapes: the first B of a partial Fisher-Yates shuffle
     // (the same on every rank: rng_ is).
@@ -147,75 +166,13 @@ void Trainer::step() {
       std::swap(order[size_t(i)], order[size_t(i) + rng_.below(uint64_t(n - i))]);
     batch_.assign(order.begin(), order.begin() + b);
   }
-  // Each shape draws its targets and its x_P from a generator of its own, seeded
-  // by the step's key and the shape's index: the same numbers whichever rank
-  // trains the shape, and in one process (docs/mpi.md). The key comes from rng_,
-  // so a restored snapshot replays them.
-  const uint64_t key = rng_.next();
-  local_.clear();
-  for (int s : batch_)
-    if (s >= first_shape_ && s < last_shape_) local_.push_back(s);
-  targets_.resize(local_.size(), Block<float>(options_.points, 6));
-  shape_rngs_.clear();
-  for (int s : local_) shape_rngs_.emplace_back(key, uint64_t(s));
-  ObjectiveShare<float> share;
-  share.shapes = local_;
-  share.batch = b;
-  share.repulsion = first_shape_ == 0;  // rank 0: N l_rep L_rep is counted once
-  share.code_begin = first_shape_;
-  share.code_end = last_shape_;
-  // M targets {x_S, n_S} per shape, drawn with replacement from its pool.
-  for (size_t k = 0; k < local_.size(); ++k) {
-    const Block<float>& pool = pools_[size_t(local_[k])];
-    Rng& rng = shape_rngs_[k];
-    for (Index m = 0; m < options_.points; ++m)
-      targets_[k].row(m) = pool.row(Index(rng.below(uint64_t(pool.rows()))));
-    share.rngs.push_back(&rng);
-    if (!surfaces_.empty()) share.surfaces.push_back(&surfaces_[size_t(local_[k] - first_shape_)]);
-  }
-  tape_.clear();
-  const ObjectiveOptions objective{options_.weights, options_.components,
-                                   options_.repulsion_tolerance};
-  LossTerms sums;
-  Var loss = objective_share(tape_, *atlas_, targets_, options_.points, objective, share, &sums);
-  atlas_->params.zero_grad();
-  tape_.backward(loss);
-  if (iteration_ == fault_at_ && faults_to_inject_ > 0) {
-    --faults_to_inject_;
-    sums.total = std::numeric_limits<double>::quiet_NaN();
-  }
-  bool finite = std::isfinite(sums.total);
-  for (float g : atlas_->params.grads()) finite = finite && std::isfinite(g);
-  // Over MPI the flag is summed with the loss terms: when any rank saw a NaN or
-  // Inf, every rank takes the same recovery below, from the same snapshot.
-  if (team_ && team_->size() > 1) finite = exchange(sums, finite);
-  last_ = sums;
-  for (double* v :
-       {&last_.surface, &last_.chart, &last_.cycle_2d, &last_.cycle_6d, &last_.isometry})
-    *v /= b;
   StepReport report;
   report.lr = learning_rate();
-  report.terms = last_;
-  if (!finite) {
-    // Undo: back to the last good state, whole; this batch is skipped and the
-    // steps since the snapshot are redone with the smaller learning rate. Every
-    // rank takes its snapshot at the same iterations, so all rewind together.
-    FaultRecovery f;
-    f.iteration = iteration_;
-    restore_snapshot();
-    lr_scale_ *= options_.fault_lr_factor;
-    f.restored = iteration_;
-    f.lr_scale = lr_scale_;
-    fault_log_.push_back(f);
-    failed_iteration_ = std::max(failed_iteration_, f.iteration);
-    ++unresolved_faults_;
-    report.fault = &fault_log_.back();
-  } else {
-    if (iteration_ > failed_iteration_) unresolved_faults_ = 0;  // past every failure so far
-    if (iteration_ % kSnapshotEvery == 0) take_snapshot(rng_at_start);
-    adam_.step(atlas_->params, report.lr);
+  if (train_on(batch_, report.lr, false, rng_at_start, report)) {
     ++iteration_;
-    report.mirrored = choose_orientation();
+    const double first_decay = options_.decay_at.empty() ? 1.0 : options_.decay_at.front();
+    report.mirrored = choose_orientation(
+        iteration_, double(iteration_) < first_decay * double(options_.iterations));
     report.reseeded = reseed();
   }
   elapsed_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -271,14 +228,165 @@ void Trainer::gather_codes() {
   }
 }
 
-bool Trainer::choose_orientation() {
+int64_t Trainer::template_steps_for(const FitOptions& o, int64_t iterations, int shapes) {
+  if (o.template_steps >= 0) return o.template_steps;
+  if (shapes <= 1 || !(o.template_share > 0) || o.template_share >= 1) return 0;
+  // A template step costs about 1/N of a joint step (one shape instead of N).
+  return int64_t(
+      std::llround(o.template_share / (1 - o.template_share) * double(iterations) * shapes));
+}
+
+void Trainer::train_template(int64_t steps, const std::function<bool()>& cancelled) {
+  JSA_CHECK(iteration_ == 0 && !template_finished_,
+            "the template start runs before the joint training");
+  if (pools_.size() < 2 || steps <= 0) return;
+  const std::vector<int> template_batch{0};
+  // A fault rewinds template_done_ to the last snapshot: the steps are redone,
+  // so the template ends with `steps` good steps more, as a run's iterations do.
+  const int64_t target = template_done_ + steps;
+  while (template_done_ < target) {
+    if (cancelled && cancelled()) return;
+    const std::array<uint64_t, 4> rng_at_start = rng_.state();
+    StepReport report;
+    if (!train_on(template_batch, lr_scale_ * options_.lr, true, rng_at_start, report)) {
+      if (unresolved_faults_ > options_.max_faults)
+        throw NumericalFault(unresolved_faults_, failed_iteration_);
+      continue;
+    }
+    ++template_done_;
+    // Until the joint run, the template's orientation is chosen as a run's is.
+    choose_orientation(template_done_, true);
+  }
+}
+
+void Trainer::finish_template() {
+  if (template_finished_) return;
+  template_finished_ = true;
+  if (template_done_ == 0 || !atlas_->has_codes()) return;
+  // Every shape starts as the template: f_i <- f_0 for phi and psi, and the same
+  // for Adam's moments of the codes, so the first joint steps are the template's.
+  for (const char* name : {"codes.phi", "codes.psi"}) {
+    const int id = atlas_->params.find(name);
+    JSA_CHECK(id >= 0, "the atlas has no " << name);
+    const auto& e = atlas_->params.entry(id);
+    for (std::vector<float>* buffer :
+         {&atlas_->params.values(), &adam_.first_moment(), &adam_.second_moment()}) {
+      if (buffer->empty()) continue;
+      float* block = buffer->data() + e.offset;  // rows x cols, row-major: one code per row
+      for (Index r = 1; r < e.rows; ++r)
+        for (Index c = 0; c < e.cols; ++c) block[r * e.cols + c] = block[c];
+    }
+  }
+  take_snapshot(rng_.state());  // a fault in the joint run must not undo the copy
+}
+
+bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_step,
+                       const std::array<uint64_t, 4>& rng_at_start, StepReport& report) {
+  const int b = int(batch.size());
+  const int64_t counter = template_step ? template_done_ : iteration_;
+  // Each shape draws its targets and its x_P from a generator of its own, seeded
+  // by the step's key and the shape's index: the same numbers whichever rank
+  // trains the shape, and in one process (docs/mpi.md). The key comes from rng_,
+  // so a restored snapshot replays them.
+  const uint64_t key = rng_.next();
+  local_.clear();
+  for (int s : batch)
+    if (s >= first_shape_ && s < last_shape_) local_.push_back(s);
+  targets_.resize(local_.size(), Block<float>(options_.points, 6));
+  shape_rngs_.clear();
+  for (int s : local_) shape_rngs_.emplace_back(key, uint64_t(s));
+  ObjectiveShare<float> share;
+  share.shapes = local_;
+  share.batch = b;
+  share.repulsion = first_shape_ == 0;  // rank 0: N l_rep L_rep is counted once
+  share.code_begin = first_shape_;
+  share.code_end = last_shape_;
+  // M targets {x_S, n_S} per shape, drawn with replacement from its pool.
+  for (size_t k = 0; k < local_.size(); ++k) {
+    const Block<float>& pool = pools_[size_t(local_[k])];
+    Rng& rng = shape_rngs_[k];
+    for (Index m = 0; m < options_.points; ++m)
+      targets_[k].row(m) = pool.row(Index(rng.below(uint64_t(pool.rows()))));
+    share.rngs.push_back(&rng);
+    if (!surfaces_.empty()) share.surfaces.push_back(&surfaces_[size_t(local_[k] - first_shape_)]);
+  }
+  tape_.clear();
+  ObjectiveOptions objective{options_.weights, options_.components, options_.repulsion_tolerance};
+  // The staged objective (FitOptions::chart_from): phi and P alone at first.
+  if (double(iteration_) < options_.chart_from * double(options_.iterations))
+    objective.components.chart = false;
+  LossTerms sums;
+  Var loss = objective_share(tape_, *atlas_, targets_, options_.points, objective, share, &sums);
+  atlas_->params.zero_grad();
+  tape_.backward(loss);
+  // The test hook counts joint iterations only (the template start has none).
+  if (!template_step && counter == fault_at_ && faults_to_inject_ > 0) {
+    --faults_to_inject_;
+    sums.total = std::numeric_limits<double>::quiet_NaN();
+  }
+  bool finite = std::isfinite(sums.total);
+  for (float g : atlas_->params.grads()) finite = finite && std::isfinite(g);
+  // Over MPI the flag is summed with the loss terms: when any rank saw a NaN or
+  // Inf, every rank takes the same recovery below, from the same snapshot.
+  if (team_ && team_->size() > 1) finite = exchange(sums, finite);
+  last_ = sums;
+  for (double* v :
+       {&last_.surface, &last_.chart, &last_.cycle_2d, &last_.cycle_6d, &last_.isometry})
+    *v /= b;
+  report.terms = last_;
+  // Template steps and joint iterations in one increasing count: the template
+  // runs whole before iteration 0, and its snapshot is never restored after.
+  const int64_t position = template_done_ + iteration_;
+  if (!finite) {
+    // Undo: back to the last good state, whole; this batch is skipped and the
+    // steps since the snapshot are redone with the smaller learning rate. Every
+    // rank takes its snapshot at the same iterations, so all rewind together.
+    FaultRecovery f;
+    f.iteration = counter;
+    f.template_step = template_step;
+    restore_snapshot();
+    lr_scale_ *= options_.fault_lr_factor;
+    f.restored = template_step ? template_done_ : iteration_;
+    f.lr_scale = lr_scale_;
+    fault_log_.push_back(f);
+    if (position >= failed_position_) {
+      failed_position_ = position;
+      failed_iteration_ = counter;
+    }
+    ++unresolved_faults_;
+    report.fault = &fault_log_.back();
+    return false;
+  }
+  if (position > failed_position_) unresolved_faults_ = 0;  // past every failure so far
+  if (counter % kSnapshotEvery == 0) take_snapshot(rng_at_start);
+  if (options_.code_lr_scale != 1 && atlas_->has_codes()) {
+    // Adam's update of the codes, scaled: theta <- old + s (theta_Adam - old).
+    std::vector<std::pair<size_t, std::vector<float>>> before;
+    for (const char* name : {"codes.phi", "codes.psi"}) {
+      const auto& e = atlas_->params.entry(atlas_->params.find(name));
+      const float* v = atlas_->params.values().data() + e.offset;
+      before.emplace_back(size_t(e.offset), std::vector<float>(v, v + e.rows * e.cols));
+    }
+    adam_.step(atlas_->params, lr);
+    const float s = float(options_.code_lr_scale);
+    for (const auto& [offset, old] : before) {
+      float* v = atlas_->params.values().data() + offset;
+      for (size_t k = 0; k < old.size(); ++k) v[k] = old[k] + s * (v[k] - old[k]);
+    }
+  } else {
+    adam_.step(atlas_->params, lr);
+  }
+  batch_step_ = batch;
+  return true;
+}
+
+bool Trainer::choose_orientation(int64_t counter, bool in_window) {
   const int every = options_.orient_every;
-  if (every <= 0 || !options_.components.normals || iteration_ % every != 0) return false;
-  const double first_decay = options_.decay_at.empty() ? 1.0 : options_.decay_at.front();
-  if (double(iteration_) >= first_decay * double(options_.iterations)) return false;
+  if (every <= 0 || !options_.components.normals || counter % every != 0 || !in_window)
+    return false;
   // Its own streams, one per shape: the check does not shift the draws of the
   // training steps, and a shape draws the same on any rank.
-  const Rng check(options_.seed, 1000 + uint64_t(iteration_ / every));
+  const Rng check(options_.seed, 1000 + uint64_t(counter / every));
   double back = 0;
   for (size_t i = 0; i < targets_.size(); ++i) {
     Rng rng = check.stream(uint64_t(local_[i]));
@@ -286,7 +394,7 @@ bool Trainer::choose_orientation() {
                                  local_[i]);
   }
   if (team_ && team_->size() > 1) team_->sum_in_rank_order(&back, 1);
-  if (back / double(batch_.size()) <= 0.5) return false;
+  if (back / double(batch_step_.size()) <= 0.5) return false;
   mirror_domain(*atlas_, {&adam_.first_moment(), &adam_.second_moment()});
   ++mirrors_;
   take_snapshot(rng_.state());  // a fault must not restore the unmirrored state
@@ -304,13 +412,13 @@ int Trainer::reseed() {
   // Targets from the pools: more than a step's M, so that holes are seen.
   const Index count = 4 * options_.points;
   std::vector<Block<float>> targets;
-  for (int s : batch_) {
+  for (int s : batch_step_) {
     const Block<float>& pool = pools_[size_t(s)];
     Block<float> t(count, 6);
     for (Index m = 0; m < count; ++m) t.row(m) = pool.row(Index(rng.below(uint64_t(pool.rows()))));
     targets.push_back(std::move(t));
   }
-  const ReseedReport r = reseed_flipped_means(*atlas_, targets, batch_, rng,
+  const ReseedReport r = reseed_flipped_means(*atlas_, targets, batch_step_, rng,
                                               {&adam_.first_moment(), &adam_.second_moment()});
   if (r.flipped == 0) return 0;
   reseeded_ += r.flipped;
@@ -333,16 +441,20 @@ TrainerState Trainer::save_state() const {
   }
   st.rng = nlohmann::json{{"xoshiro256", rng_.state()}}.dump();
   nlohmann::json faults = nlohmann::json::array();
-  for (const FaultRecovery& f : fault_log_)
-    faults.push_back(nlohmann::json{
-        {"iteration", f.iteration}, {"restored", f.restored}, {"lr_scale", f.lr_scale}});
-  st.progress = nlohmann::json{
-      {"iteration", iteration_},
-      {"lr_scale", lr_scale_},
-      {"faults", faults},
-      {"mirrors", mirrors_},
-      {"reseeded",
-       reseeded_}}.dump();
+  for (const FaultRecovery& f : fault_log_) {
+    nlohmann::json j = {
+        {"iteration", f.iteration}, {"restored", f.restored}, {"lr_scale", f.lr_scale}};
+    if (f.template_step) j["template"] = true;
+    faults.push_back(j);
+  }
+  st.progress = nlohmann::json{{"iteration", iteration_},
+                               {"lr_scale", lr_scale_},
+                               {"faults", faults},
+                               {"mirrors", mirrors_},
+                               {"reseeded", reseeded_},
+                               {"template_steps_done", template_done_},
+                               {"template_finished", template_finished_}}
+                    .dump();
   return st;
 }
 
@@ -374,6 +486,8 @@ void Trainer::load_state(const TrainerState& st, const std::string& what) {
   std::array<uint64_t, 4> s{};
   std::vector<FaultRecovery> faults;
   int mirrors = 0, reseeded = 0;
+  int64_t template_done = 0;
+  bool template_finished = false;
   try {
     const nlohmann::json r = nlohmann::json::parse(st.rng), p = nlohmann::json::parse(st.progress);
     // Integers only: nlohmann converts a float such as 1e300 with static_cast (undefined).
@@ -397,13 +511,18 @@ void Trainer::load_state(const TrainerState& st, const std::string& what) {
     reseeded = int(std::clamp<int64_t>(integer(p.at("reseeded")), -1, INT32_MAX));
     for (const nlohmann::json& f : p.at("faults")) {
       if (!f.at("lr_scale").is_number()) throw std::runtime_error("expected a number");
-      faults.push_back(
-          {integer(f.at("iteration")), integer(f.at("restored")), f.at("lr_scale").get<double>()});
+      FaultRecovery r{integer(f.at("iteration")), integer(f.at("restored")),
+                      f.at("lr_scale").get<double>()};
+      if (f.contains("template")) r.template_step = f.at("template").get<bool>();
+      faults.push_back(r);
     }
+    // Written since the template start (coll); older states had none.
+    if (p.contains("template_steps_done")) template_done = integer(p.at("template_steps_done"));
+    if (p.contains("template_finished")) template_finished = p.at("template_finished").get<bool>();
   } catch (const std::exception& e) {
     throw InputError(what + ": malformed RNG or progress state (" + e.what() + ")");
   }
-  if (it < 0 || steps < 0 || mirrors < 0 || reseeded < 0)
+  if (it < 0 || steps < 0 || mirrors < 0 || reseeded < 0 || template_done < 0)
     throw InputError(what + ": negative count in the training state");
   if (!(scale > 0 && scale <= 1)) throw InputError(what + ": bad learning-rate scale");
   iteration_ = it;
@@ -415,6 +534,8 @@ void Trainer::load_state(const TrainerState& st, const std::string& what) {
   fault_log_ = std::move(faults);
   mirrors_ = mirrors;
   reseeded_ = reseeded;
+  template_done_ = template_done;
+  template_finished_ = template_finished || it > 0;
   take_snapshot(rng_.state());
 }
 

@@ -70,6 +70,26 @@ struct FitOptions {
   // L_6D's dense variant (losses/chamfer.h): phi6(x_P) is matched in the whole
   // pool instead of the step's M targets; the targets' direction is unchanged.
   bool dense_surface = true;
+  // Collections: before the joint training, fit shape 0 alone (the template)
+  // for this many steps at the base learning rate, then copy its codes to every
+  // shape, so that all shapes start from one surface and one layout of the
+  // domain (beyond the paper: "template start", docs/collections.md). A template step costs about
+  // 1/N of a joint step. -1: chosen from template_share (the CLI times the
+  // steps under --minutes; otherwise share / (1 - share) * iterations * N).
+  int64_t template_steps = 0;
+  // Collections: turn every shape into the pose of the first before fitting
+  // (io/geometry/rigid_align.h, applied by the caller: model/tool/shape_input.h).
+  bool align_poses = true;
+  // Staged objective: until this fraction of the iterations, train phi and P
+  // alone (no psi, no L_2D, no L_cycle; Table 1 row 9's objective), then the
+  // full method. 0: the full method from the start, as the paper.
+  double chart_from = 0;
+  // Collections: the latent codes' learning rate as a multiple of the networks'
+  // (a per-group rate: the codes' Adam steps are scaled by it). 1: one rate.
+  double code_lr_scale = 1;
+  // Share of the run's cost spent on the template (when template_steps < 0).
+  // `jsatlas fit` starts collections with -1 and 0.3 (docs/collections.md).
+  double template_share = 0;
 };
 
 // The paper's method (Sec. 3) and nothing beyond it: ReLU MLPs, normals scaled
@@ -86,6 +106,9 @@ inline void apply_paper_method(FitOptions& o) {
   o.reseed_every = 0;
   o.orient_every = 0;
   o.weights.cycle = LossWeights{}.cycle;  // the paper's lambda_cycle (mean convention)
+  o.template_steps = 0;                   // the paper trains all shapes jointly from the start
+  o.template_share = 0;
+  o.align_poses = false;  // and takes the shapes in the poses given
 }
 
 // `--preset paper`: the paper's method at the paper's sizes (Sec. 3,
@@ -112,6 +135,7 @@ struct FaultRecovery {
       0;  // the iteration of the restored state; steps restored..iteration are redone
   double lr_scale =
       1;  // the learning-rate scale from now on (FitOptions::fault_lr_factor per fault)
+  bool template_step = false;  // in the template start: iteration and restored count its steps
 };
 // One line for logs and reports: what happened and what was done.
 std::string describe(const FaultRecovery& f);
@@ -179,6 +203,17 @@ class Trainer {
   // has not run; step() calls it before the first iteration. A resumed run
   // (iteration > 0) never wraps.
   WrapReport wrap(const std::function<bool()>& cancelled = {});
+  // The template start (FitOptions::template_steps): `steps` more Adam steps on
+  // shape 0 alone at the base learning rate. Only before the first iteration of
+  // a collection; may be called several times. finish_template() then copies
+  // shape 0's codes (and their Adam moments) to every shape. step() runs both
+  // itself, with options().template_steps, if they have not run.
+  void train_template(int64_t steps, const std::function<bool()>& cancelled = {});
+  void finish_template();
+  int64_t template_done() const { return template_done_; }
+  // template_steps resolved from template_share for a run of `iterations` joint steps.
+  static int64_t template_steps_for(const FitOptions& o, int64_t iterations, int shapes);
+  void set_template_steps(int64_t n) { options_.template_steps = n; }
   double learning_rate() const;  // the schedule at the current iteration, times the fault scale
   int faults() const { return int(fault_log_.size()); }
   const std::vector<FaultRecovery>& fault_log() const {
@@ -235,29 +270,38 @@ class Trainer {
   LossTerms last_;
   std::vector<Block<float>> targets_;  // per shape of local_
   std::vector<int> batch_;       // the shapes of the step (all N without batching), on every rank
-  std::vector<int> local_;       // those of this rank's block
+  std::vector<int> local_;       // those of the last step's batch in this rank's block
   std::vector<Rng> shape_rngs_;  // per shape of local_: its draws this step
+  std::vector<int> batch_step_;  // the shapes of the last step taken, on every rank
   StepCallback progress_;
   // The last good state: everything the next step depends on. Over MPI every
   // rank takes it at the same iteration and restores it together.
   struct Snapshot {
     std::vector<float> params, m, v;
-    int64_t adam_steps = 0, iteration = 0;
+    int64_t adam_steps = 0, iteration = 0, template_done = 0;
     std::array<uint64_t, 4> rng{};
   } good_;
   double lr_scale_ = 1.0;
   std::vector<FaultRecovery> fault_log_;
   int unresolved_faults_ = 0;      // recoveries since the run last got past a failing iteration
-  int64_t failed_iteration_ = -1;  // the furthest iteration that failed
+  int64_t failed_iteration_ = -1;  // the furthest iteration (or template step) that failed
+  int64_t failed_position_ = -1;   // the same, as template steps + iterations
   int64_t fault_at_ = -1;
   int faults_to_inject_ = 0;
   int mirrors_ = 0;
   int reseeded_ = 0;
   bool wrapped_ = false;
+  int64_t template_done_ = 0;  // template steps taken (FitOptions::template_steps)
+  bool template_finished_ = false;
   double elapsed_ = 0;
   void take_snapshot(const std::array<uint64_t, 4>& rng_state);
   void restore_snapshot();
-  bool choose_orientation();
+  // One Adam step on the shapes of `batch` at rate lr, counted as a joint
+  // iteration or a template step. On a NaN/Inf the state goes back to the
+  // last good snapshot, the recovery is logged and returned in `report`; false.
+  bool train_on(const std::vector<int>& batch, double lr, bool template_step,
+                const std::array<uint64_t, 4>& rng_at_start, StepReport& report);
+  bool choose_orientation(int64_t counter, bool in_window);
   int reseed();
   bool exchange(LossTerms& sums, bool finite);
 };

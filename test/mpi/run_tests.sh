@@ -6,7 +6,8 @@
 #   determinism  mpirun -np 2 a second time: bit-identical to np2's checkpoint
 #   resume       -np 2 stopped at iteration 6, resumed with -np 3: within BOUND
 #   batch        --batch-shapes 3 on 1 process and on 2 ranks: within BOUND
-#   errors       more ranks than shapes, --wrap over 2 ranks: a one-line error, the job ends non-zero
+#   errors       more ranks than shapes, --wrap or --template-steps over 2 ranks: a one-line
+#                error, the job ends non-zero
 # Usage: run_tests.sh MODE JSATLAS COMPARE MPIEXEC WORKDIR BOUND
 set -euo pipefail
 mode=$1 jsatlas=$2 compare=$3 mpiexec=$4 work=$5 bound=$6
@@ -14,8 +15,12 @@ mkdir -p "$work"
 cd "$work"
 printf 'builtin:sphere\nbuiltin:torus\nbuiltin:cube\nbuiltin:capsule\n' > shapes.txt
 # Small enough for seconds per run; orientation checks every 4 steps exercise its sum over ranks.
+# The pose step (--align, the default) runs on every rank, so the comparisons
+# cover it. No template start (refused on more than one rank; its automatic
+# length is 0 there): the 1-process reference must train the same way.
 fit=(fit --list shapes.txt --iters 12 -M 64 -K 64 --width 16 --depth 2 --code-size 8 --pool 2000
-     --threads 1 --orient-every 4 --mesh-resolution 8 --checkpoint-every 0 --seed 5 -q)
+     --threads 1 --orient-every 4 --mesh-resolution 8 --checkpoint-every 0 --seed 5 -q
+     --template-steps 0)
 launch=("$mpiexec" --oversubscribe --bind-to none)
 [ "$(id -u)" -eq 0 ] && launch+=(--allow-run-as-root)
 run() {  # run NP ARGS...: one process without mpirun, else NP ranks
@@ -32,7 +37,8 @@ case "$mode" in
     "$compare" one/model.ckpt "$mode/model.ckpt" "$bound"
     # Rank 0 wrote every output of the collection.
     for i in 0 1 2 3; do test -s "$mode/shape_$i/domain_mesh.obj"; done
-    test -s "$mode/losses.csv" ;;
+    test -s "$mode/losses.csv"
+    cmp one/rotations.json "$mode/rotations.json" ;;
   determinism)
     rm -rf np2_again && run 2 "${fit[@]}" -o np2_again
     "$compare" np2/model.ckpt np2_again/model.ckpt
@@ -57,6 +63,8 @@ case "$mode" in
       grep -q -- "$message" err.txt || { echo "errors: no '$message' in:"; cat err.txt; exit 1; }
     }
     expect_error "2 MPI ranks for 1 shapes" 2 fit builtin:sphere -o too_many --iters 2 -q
-    expect_error "--wrap is not supported with more than one MPI rank" 2 "${fit[@]}" --wrap 5 -o wrapped ;;
+    expect_error "--wrap is not supported with more than one MPI rank" 2 "${fit[@]}" --wrap 5 -o wrapped
+    expect_error "--template-steps is not supported with more than one MPI rank" 2 fit --list \
+      shapes.txt --iters 2 --template-steps 5 -o templated -q ;;
   *) echo "run_tests.sh: unknown mode $mode"; exit 2 ;;
 esac

@@ -1,0 +1,156 @@
+// Principal axes, their proper sign and order candidates, ICP, lowest Chamfer.
+#include "io/geometry/rigid_align.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "engine/check.h"
+#include "io/geometry/nearest.h"
+
+namespace jsa {
+namespace {
+
+// Eigenvectors of the second moments as columns, eigenvalues ascending, det = +1.
+void principal_axes(const Block<double>& p, Eigen::Matrix3d& axes, Eigen::Vector3d& values) {
+  const Eigen::Matrix3d c = p.transpose() * p / double(p.rows());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(c);
+  axes = eig.eigenvectors();
+  values = eig.eigenvalues();
+  if (axes.determinant() < 0) axes.col(2) *= -1;
+}
+
+// The rotation R minimising sum |x_i R - y_i|^2 (rows), from H = sum x_i^T y_i:
+// R = U D V^T with H = U S V^T and D = diag(1, 1, det(U V^T)) (Kabsch).
+Eigen::Matrix3d kabsch(const Eigen::Matrix3d& h) {
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+  d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1 : 1;
+  return svd.matrixU() * d * svd.matrixV().transpose();
+}
+
+struct Sets {
+  const Block<double>& moving;
+  const Block<double>& fixed;
+  const NearestIndex<double>& moving_index;
+  const NearestIndex<double>& fixed_index;
+};
+
+// Symmetric Chamfer of (moving R, fixed), and the Kabsch update from the same pairs.
+double chamfer_and_update(const Sets& s, const Eigen::Matrix3d& r, Eigen::Matrix3d* next) {
+  std::vector<int> nn;
+  std::vector<double> d2;
+  const Block<double> moved = s.moving * r;
+  s.fixed_index.query(moved, nn, &d2);
+  double forward = 0;
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  for (Index i = 0; i < moved.rows(); ++i) {
+    forward += d2[size_t(i)];
+    h += s.moving.row(i).transpose() * s.fixed.row(nn[size_t(i)]);
+  }
+  // |x R - y| = |x - y R^T|: the fixed points' neighbours among the unmoved ones.
+  const Block<double> back = s.fixed * r.transpose();
+  s.moving_index.query(back, nn, &d2);
+  double backward = 0;
+  for (Index j = 0; j < back.rows(); ++j) {
+    backward += d2[size_t(j)];
+    h += s.moving.row(nn[size_t(j)]).transpose() * s.fixed.row(j);
+  }
+  if (next) *next = kabsch(h);
+  return forward / double(moved.rows()) + backward / double(back.rows());
+}
+
+}  // namespace
+
+double rotation_angle_degrees(const Eigen::Matrix3d& r) {
+  const double c = std::clamp((r.trace() - 1) / 2, -1.0, 1.0);
+  return std::acos(c) * 180.0 / M_PI;
+}
+
+double RigidAlignment::angle_degrees() const { return rotation_angle_degrees(rotation); }
+
+RigidAlignment rigid_align(const Block<double>& moving_all, const Block<double>& fixed_all,
+                           const RigidAlignOptions& o) {
+  JSA_CHECK(moving_all.cols() == 3 && fixed_all.cols() == 3, "rigid_align takes N x 3 points");
+  JSA_CHECK(moving_all.rows() >= 4 && fixed_all.rows() >= 4,
+            "rigid_align needs at least 4 points per set");
+  JSA_CHECK(o.samples >= 4 && o.icp_iterations >= 0 && o.final_iterations >= 0,
+            "bad rigid_align options");
+  const Block<double> moving = moving_all.topRows(std::min(o.samples, moving_all.rows()));
+  const Block<double> fixed = fixed_all.topRows(std::min(o.samples, fixed_all.rows()));
+  const NearestIndex<double> moving_index(moving), fixed_index(fixed);
+  const Sets sets{moving, fixed, moving_index, fixed_index};
+
+  Eigen::Matrix3d vm, vf;
+  Eigen::Vector3d lm, lf;
+  principal_axes(moving, vm, lm);
+  principal_axes(fixed, vf, lf);
+  // Axes a and b may be exchanged when their eigenvalues are close in either set.
+  auto close = [&](int a, int b) {
+    for (const Eigen::Vector3d* l : {&lm, &lf}) {
+      const double hi = std::max((*l)(a), (*l)(b));
+      if (hi <= 0 || std::abs((*l)(a) - (*l)(b)) <= o.close_eigenvalues * hi) return true;
+    }
+    return false;
+  };
+
+  // Candidates in a fixed order: the identity order of axes first, and within
+  // an order the sign patterns from (+, +, +).
+  std::array<int, 3> perm{0, 1, 2};
+  std::vector<Eigen::Matrix3d> candidates;
+  do {
+    bool allowed = true;
+    for (int a = 0; a < 3; ++a)
+      allowed = allowed && (perm[size_t(a)] == a || close(a, perm[size_t(a)]));
+    if (!allowed) continue;
+    for (int signs = 0; signs < 8; ++signs) {
+      Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+      for (int a = 0; a < 3; ++a) m(a, perm[size_t(a)]) = (signs >> a) & 1 ? -1.0 : 1.0;
+      if (m.determinant() < 0) continue;  // a reflection: never a change of pose
+      // x -> coordinates on the moving axes (x vm) -> the fixed axes (m) -> space (vf^T).
+      candidates.push_back(vm * m * vf.transpose());
+    }
+  } while (std::next_permutation(perm.begin(), perm.end()));
+
+  auto icp = [&](Eigen::Matrix3d r, int iterations) {
+    Eigen::Matrix3d next;
+    for (int k = 0; k < iterations; ++k) {
+      chamfer_and_update(sets, r, &next);
+      const double change = (next - r).cwiseAbs().maxCoeff();
+      r = next;
+      if (change < 1e-10) break;
+    }
+    return r;
+  };
+  // The input's own pose first.
+  candidates.insert(candidates.begin(), Eigen::Matrix3d::Identity());
+  std::vector<Eigen::Matrix3d> refined;
+  std::vector<double> scores;
+  for (const Eigen::Matrix3d& start : candidates) {
+    refined.push_back(icp(start, o.icp_iterations));
+    scores.push_back(chamfer_and_update(sets, refined.back(), nullptr));
+  }
+  size_t best = 0;
+  for (size_t c = 1; c < scores.size(); ++c)
+    if (scores[c] < scores[best]) best = c;
+  RigidAlignment out;
+  out.input_chamfer = scores[0];
+  if (best != 0 && o.keep_input > 0 && scores[0] <= o.keep_input * scores[best]) {
+    best = 0;
+    out.kept_input = true;
+  }
+  out.rotation = icp(refined[best], o.final_iterations);
+  out.chamfer = chamfer_and_update(sets, out.rotation, nullptr);
+  out.candidates = int(candidates.size());
+  out.runner_up = -1;
+  for (size_t c = 0; c < scores.size(); ++c) {
+    if (rotation_angle_degrees(refined[c].transpose() * refined[best]) <= 10) continue;
+    if (out.runner_up < 0 || scores[c] < out.runner_up) out.runner_up = scores[c];
+  }
+  return out;
+}
+
+}  // namespace jsa

@@ -1,0 +1,60 @@
+// Rigid alignment of one point set onto another by a rotation about the origin
+// (both centred at their means, as the unit frame puts them): the pose step of a
+// collection (shapes stored in their authors' frames are turned into the frame
+// of the first shape before the shared atlas sees them; docs/collections.md).
+//
+//   1. principal axes of both sets (eigenvectors of the second moments);
+//   2. candidates: the rotations that carry one set of axes onto the other,
+//      x -> x V_m S V_f^T with S a diagonal of signs and det = +1 (4 candidates),
+//      and, when two eigenvalues are close (the axes are not defined), every
+//      order of those axes as well (up to 24: the rotations of a cube);
+//   3. each candidate refined by point-to-point ICP, rotation only (Kabsch on
+//      the nearest pairs of both directions);
+//   4. the refined candidate with the lowest symmetric Chamfer distance wins;
+//      ties keep the earlier candidate (the fixed order above, identity first),
+//      except that ICP from the input's own pose wins when it is within
+//      `keep_input` of the best (families of shapes are often stored aligned,
+//      and near-symmetric ones, like an ant end to end, score two poses alike);
+//      the winner gets more ICP steps, until the rotation stops changing.
+// Symmetric shapes: a mirror is never a candidate (det = +1), so a left/right
+// symmetric shape cannot come out reflected; a shape with a front/back or
+// top/bottom symmetry has two candidates of about the same Chamfer, and the
+// report gives the runner-up's score so the caller can tell (`margin`).
+#pragma once
+#include <cstdint>
+
+#include "engine/block.h"
+
+namespace jsa {
+
+struct RigidAlignOptions {
+  Index samples = 3000;        // points of each set used (the first rows; pools are random draws)
+  int icp_iterations = 40;     // ICP steps per candidate
+  int final_iterations = 500;  // more ICP steps for the winner (point-to-point ICP slides slowly
+                               // along directions a near-symmetric shape hardly pins)
+  double close_eigenvalues = 0.15;  // relative gap |l_a - l_b| / l_a under which axes a, b may swap
+  // The input's own pose (ICP started at the identity) is kept when its Chamfer
+  // is within this factor of the best candidate's: a collection stored aligned
+  // stays as it is unless another pose is clearly better (0: always the best).
+  double keep_input = 1.25;
+};
+
+struct RigidAlignment {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // rows: moving x -> x * rotation ~ fixed
+  double chamfer = 0;            // symmetric Chamfer (mean squared distance, both ways) after ICP
+  double runner_up = 0;          // the best Chamfer of a candidate that ends > 10 degrees away
+  int candidates = 0;            // rotations tried (the input's pose and the axis candidates)
+  double input_chamfer = 0;      // ICP from the input's own pose
+  bool kept_input = false;       // the input's pose won by the keep_input rule
+  double angle_degrees() const;  // of `rotation`
+};
+
+// moving, fixed: N x 3 and M x 3 points (any N, M >= 4), centred at the origin.
+// Deterministic: no random draws, nearest neighbours with a fixed tie rule.
+RigidAlignment rigid_align(const Block<double>& moving, const Block<double>& fixed,
+                           const RigidAlignOptions& options = {});
+
+// The angle of a rotation matrix, in degrees (0 for the identity, 180 at most).
+double rotation_angle_degrees(const Eigen::Matrix3d& r);
+
+}  // namespace jsa
