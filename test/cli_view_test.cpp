@@ -17,12 +17,14 @@ const std::string kSmall =
 
 std::vector<std::uint8_t> unbase64(const std::string& s) {
   std::vector<std::uint8_t> out;
-  int bits = 0, value = 0;
+  // Only the last 14 bits are ever read, so keep no more (an int would overflow).
+  int bits = 0;
+  std::uint32_t value = 0;
   for (const char ch : s) {
     const char* const table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     const char* at = std::strchr(table, ch);
     if (ch == '=' || !at || !*at) continue;
-    value = (value << 6) | int(at - table);
+    value = ((value << 6) | std::uint32_t(at - table)) & 0x3fffu;
     bits += 6;
     if (bits >= 8) out.push_back(std::uint8_t((value >> (bits - 8)) & 0xff)), bits -= 8;
   }
