@@ -80,50 +80,62 @@ Var relu_masked(Tape<T>& t, Var x, Index m) {
 // continuously over the domain; the price is the second derivative in the
 // pull-back:  dz += dy_0 s'(z) + sum_k dy_k x_k s''(z),  s'' = beta s' (1 - s'),
 //             dx_k += dy_k s'(z).
+// The same identities as the scalar rule of engine/dual.h (softplus), here over
+// whole rows so that Eigen vectorises exp and log1p.
+// Fused: one pass per point i over its value row and its tangent rows, in the
+// forward and in the pull-back, with the row's e^-|bz| and s' in stack arrays
+// (no heap allocation in the step; kMaxWidth is the command line's width bound).
+// The pull-back recomputes e^-|bz| rather than keeping s' from the forward: an
+// exp per element is cheaper than a stored block per layer (memory, issue 21).
+namespace {
+constexpr int kMaxWidth = 4096;
+template <class T>
+using RowArray = Eigen::Array<T, 1, Eigen::Dynamic, Eigen::RowMajor, 1, kMaxWidth>;
+}  // namespace
+
 template <class T>
 Var softplus_stacked(Tape<T>& t, Var x, Index m, T beta) {
   const Index n = t.rows(x), c = t.cols(x);
   JSA_CHECK(m > 0 && n % m == 0, "softplus_stacked: " << n << " rows is not a multiple of " << m);
   JSA_CHECK(beta > T(0), "softplus_stacked: beta must be positive, got " << beta);
+  JSA_CHECK(c <= kMaxWidth, "softplus_stacked: " << c << " columns, at most " << kMaxWidth);
   Var y = t.node(n, c, {x});
   const Block<T>& X = t.value(x);
   Block<T>& Y = t.value(y);
   const Index blocks = n / m;
-  // Whole-row-range array expressions, so Eigen vectorises exp and log1p.
   // log(1 + e^bz) = max(bz, 0) + log1p(e^-|bz|) and sigmoid(bz) = 1 / (1 + e^-bz)
   // written with e = e^-|bz| <= 1: neither overflows for any bz.
   parallel_rows(m, [&](Index r0, Index r1) {
-    const auto bz = beta * X.middleRows(r0, r1 - r0).array();
-    const Eigen::Array<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> e = (-bz.abs()).exp();
-    Y.middleRows(r0, r1 - r0).array() = (bz.max(T(0)) + e.log1p()) / beta;
-    if (blocks > 1) {
-      const Eigen::Array<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> s1 =
-          (bz >= T(0)).select(T(1) / (T(1) + e), e / (T(1) + e));
-      for (Index k = 1; k < blocks; ++k)
-        Y.middleRows(k * m + r0, r1 - r0).array() = s1 * X.middleRows(k * m + r0, r1 - r0).array();
+    RowArray<T> bz(c), e(c), s1(c);
+    for (Index i = r0; i < r1; ++i) {
+      bz = beta * X.row(i).array();
+      e = (-bz.abs()).exp();
+      Y.row(i).array() = (bz.max(T(0)) + e.log1p()) / beta;
+      if (blocks == 1) continue;
+      s1 = (bz >= T(0)).select(T(1) / (T(1) + e), e / (T(1) + e));
+      for (Index k = 1; k < blocks; ++k) Y.row(k * m + i).array() = s1 * X.row(k * m + i).array();
     }
   });
-  t.on_backward(y, [x, m, blocks, beta](Tape<T>& t, Var y) {
+  t.on_backward(y, [x, m, blocks, beta, c](Tape<T>& t, Var y) {
     const Block<T>& X = t.value(x);
     const Block<T>& dY = t.grad(y);
     Block<T>& dX = t.grad(x);
     parallel_rows(m, [&](Index r0, Index r1) {
-      const Index h = r1 - r0;
-      const auto bz = beta * X.middleRows(r0, h).array();
-      const Eigen::Array<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> e = (-bz.abs()).exp();
-      const Eigen::Array<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> s1 =
-          (bz >= T(0)).select(T(1) / (T(1) + e), e / (T(1) + e));
-      Eigen::Array<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> dz =
-          dY.middleRows(r0, h).array() * s1;
-      if (blocks > 1) {
-        const Eigen::Array<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> s2 =
-            beta * s1 * (T(1) - s1);
-        for (Index k = 1; k < blocks; ++k) {
-          dz += dY.middleRows(k * m + r0, h).array() * X.middleRows(k * m + r0, h).array() * s2;
-          dX.middleRows(k * m + r0, h).array() += dY.middleRows(k * m + r0, h).array() * s1;
+      RowArray<T> bz(c), e(c), s1(c), s2(c), dz(c);
+      for (Index i = r0; i < r1; ++i) {
+        bz = beta * X.row(i).array();
+        e = (-bz.abs()).exp();
+        s1 = (bz >= T(0)).select(T(1) / (T(1) + e), e / (T(1) + e));
+        dz = dY.row(i).array() * s1;
+        if (blocks > 1) {
+          s2 = beta * s1 * (T(1) - s1);
+          for (Index k = 1; k < blocks; ++k) {
+            dz += dY.row(k * m + i).array() * X.row(k * m + i).array() * s2;
+            dX.row(k * m + i).array() += dY.row(k * m + i).array() * s1;
+          }
         }
+        dX.row(i).array() += dz;
       }
-      dX.middleRows(r0, h).array() += dz;
     });
   });
   return y;
