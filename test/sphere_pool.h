@@ -14,7 +14,11 @@ inline jsa::Block<double> sphere_pool(jsa::Index n, uint64_t seed, double s = 1.
   for (jsa::Index i = 0; i < n; ++i) {
     Eigen::RowVector3d p(rng.normal(), rng.normal(), rng.normal());
     p.normalize();
-    pool.row(i) << p, s * p;
+    // Per coordinate: GCC 12 warns (-Warray-bounds) on Eigen's AVX-512 copy of a 3-vector row.
+    for (int k = 0; k < 3; ++k) {
+      pool(i, k) = p(k);
+      pool(i, 3 + k) = s * p(k);
+    }
   }
   return pool;
 }
