@@ -83,6 +83,8 @@ TEST_CASE(
   CHECK(o.atlas.softplus_beta == 0);
   CHECK(o.atlas.alpha == 0.01);
   CHECK(o.weights.cycle == jsa::LossWeights{}.cycle);
+  CHECK(laptop.schedule.kind == "ramp");
+  CHECK(o.schedule.kind == "step");  // the paper trains at a fixed M
 }
 
 TEST_CASE("fit config: settings added later read as what older runs did", "[fit_config]") {

@@ -67,6 +67,11 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["lr"] = o.lr;
   j["decay_at"] = o.decay_at;
   j["decay"] = o.decay;
+  j["schedule"] = {{"kind", o.schedule.kind},
+                   {"points_start", o.schedule.points_start},
+                   {"ramp_until", o.schedule.ramp_until},
+                   {"levels", o.schedule.levels},
+                   {"warmup", o.schedule.warmup}};
   j["seed"] = o.seed;
   j["repulsion_tolerance"] = o.repulsion_tolerance;
   j["max_faults"] = o.max_faults;
@@ -135,6 +140,23 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   field(j, "", "lr", o.lr);
   field(j, "", "decay_at", o.decay_at);
   field(j, "", "decay", o.decay);
+  // Added with the ramp: a file without it comes from a run at fixed M.
+  o.schedule = ScheduleOptions{};
+  o.schedule.kind = "step";
+  if (j.contains("schedule")) {
+    const json& s = j["schedule"];
+    field(s, "schedule.", "kind", o.schedule.kind);
+    field(s, "schedule.", "points_start", o.schedule.points_start);
+    field(s, "schedule.", "ramp_until", o.schedule.ramp_until);
+    field(s, "schedule.", "levels", o.schedule.levels);
+    field(s, "schedule.", "warmup", o.schedule.warmup);
+    if (o.schedule.kind != "ramp" && o.schedule.kind != "step")
+      throw InputError(what + ": field 'schedule.kind' must be \"ramp\" or \"step\"");
+    if (!(o.schedule.points_start > 0 && o.schedule.points_start <= 1) ||
+        !(o.schedule.ramp_until > 0 && o.schedule.ramp_until <= 1) || o.schedule.levels < 1 ||
+        o.schedule.levels > 1000 || !(o.schedule.warmup >= 0 && o.schedule.warmup <= 1))
+      throw InputError(what + ": a field of 'schedule' is out of range");
+  }
   field(j, "", "seed", o.seed);
   field(j, "", "repulsion_tolerance", o.repulsion_tolerance);
   field(j, "", "max_faults", o.max_faults);

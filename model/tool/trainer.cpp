@@ -47,6 +47,12 @@ static void validate(const FitOptions& o) {
   require(o.chart_from >= 0 && o.chart_from <= 1, "chart_from must be in [0, 1]");
   require(o.code_lr_scale > 0 && std::isfinite(o.code_lr_scale),
           "code_lr_scale must be positive and finite");
+  const ScheduleOptions& s = o.schedule;
+  require(s.kind == "ramp" || s.kind == "step", "schedule.kind must be ramp or step");
+  require(s.points_start > 0 && s.points_start <= 1, "schedule.points_start must be in (0, 1]");
+  require(s.ramp_until > 0 && s.ramp_until <= 1, "schedule.ramp_until must be in (0, 1]");
+  require(s.levels >= 1 && s.levels <= 1000, "schedule.levels must be in [1, 1000]");
+  require(s.warmup >= 0 && s.warmup <= 1, "schedule.warmup must be in [0, 1]");
 }
 
 Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools, Team* team)
@@ -107,10 +113,12 @@ std::string describe(const FaultRecovery& f) {
 }
 
 double Trainer::learning_rate() const {
-  std::vector<int64_t> milestones;
-  for (double f : options_.decay_at)
-    milestones.push_back(int64_t(std::llround(f * double(options_.iterations))));
-  return lr_scale_ * step_decay(options_.lr, iteration_, milestones, options_.decay);
+  return lr_scale_ * scheduled_lr(options_.schedule, options_.lr, options_.decay_at, options_.decay,
+                                  iteration_, options_.iterations);
+}
+
+Index Trainer::points() const {
+  return scheduled_points(options_.schedule, options_.points, iteration_, options_.iterations);
 }
 
 void Trainer::take_snapshot(const std::array<uint64_t, 4>& rng_state) {
@@ -231,15 +239,25 @@ void Trainer::gather_codes() {
 int64_t Trainer::template_steps_for(const FitOptions& o, int64_t iterations, int shapes) {
   if (o.template_steps >= 0) return o.template_steps;
   if (shapes <= 1 || !(o.template_share > 0) || o.template_share >= 1) return 0;
-  // A template step costs about 1/N of a joint step (one shape instead of N).
-  return int64_t(
-      std::llround(o.template_share / (1 - o.template_share) * double(iterations) * shapes));
+  // A template step costs about 1/N of a joint step at the ramp's first M (one
+  // shape instead of N); a joint step costs on average the ramp's cost ratio
+  // times that first one (1 at a fixed M).
+  const double ratio = scheduled_cost_ratio(o.schedule, o.points, kStepOverheadPoints);
+  return int64_t(std::llround(o.template_share / (1 - o.template_share) * double(iterations) *
+                              shapes * ratio));
 }
 
 void Trainer::train_template(int64_t steps, const std::function<bool()>& cancelled) {
   JSA_CHECK(iteration_ == 0 && !template_finished_,
             "the template start runs before the joint training");
   if (pools_.size() < 2 || steps <= 0) return;
+  // The template steps come before iteration 0 and do not count against the
+  // schedule: they take the M of iteration 0 (under the ramp, its first level)
+  // and the base learning rate. The template is shape 0 fitted from the random
+  // start, the regime the ramp's cheap steps are for; the ramp's levels and the
+  // decays stay fractions of the joint iterations, so --iters means the same
+  // with or without a template (and --minutes can size the two apart); and M
+  // does not drop when the joint run starts.
   const std::vector<int> template_batch{0};
   // A fault rewinds template_done_ to the last snapshot: the steps are redone,
   // so the template ends with `steps` good steps more, as a run's iterations do.
@@ -289,10 +307,12 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
   // trains the shape, and in one process (docs/mpi.md). The key comes from rng_,
   // so a restored snapshot replays them.
   const uint64_t key = rng_.next();
+  const Index points = this->points();  // the schedule's M, the same on every rank
   local_.clear();
   for (int s : batch)
     if (s >= first_shape_ && s < last_shape_) local_.push_back(s);
-  targets_.resize(local_.size(), Block<float>(options_.points, 6));
+  targets_.resize(local_.size());
+  for (Block<float>& t : targets_) t.resize(points, 6);  // a no-op within a level of the ramp
   shape_rngs_.clear();
   for (int s : local_) shape_rngs_.emplace_back(key, uint64_t(s));
   ObjectiveShare<float> share;
@@ -305,7 +325,7 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
   for (size_t k = 0; k < local_.size(); ++k) {
     const Block<float>& pool = pools_[size_t(local_[k])];
     Rng& rng = shape_rngs_[k];
-    for (Index m = 0; m < options_.points; ++m)
+    for (Index m = 0; m < points; ++m)
       targets_[k].row(m) = pool.row(Index(rng.below(uint64_t(pool.rows()))));
     share.rngs.push_back(&rng);
     if (!surfaces_.empty()) share.surfaces.push_back(&surfaces_[size_t(local_[k] - first_shape_)]);
@@ -316,7 +336,7 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
   if (double(iteration_) < options_.chart_from * double(options_.iterations))
     objective.components.chart = false;
   LossTerms sums;
-  Var loss = objective_share(tape_, *atlas_, targets_, options_.points, objective, share, &sums);
+  Var loss = objective_share(tape_, *atlas_, targets_, points, objective, share, &sums);
   atlas_->params.zero_grad();
   tape_.backward(loss);
   // The test hook counts joint iterations only (the template start has none).
@@ -390,8 +410,8 @@ bool Trainer::choose_orientation(int64_t counter, bool in_window) {
   double back = 0;
   for (size_t i = 0; i < targets_.size(); ++i) {
     Rng rng = check.stream(uint64_t(local_[i]));
-    back += back_facing_fraction(*atlas_, targets_[i], std::min<Index>(options_.points, 2000), rng,
-                                 local_[i]);
+    back += back_facing_fraction(*atlas_, targets_[i], std::min<Index>(targets_[i].rows(), 2000),
+                                 rng, local_[i]);
   }
   if (team_ && team_->size() > 1) team_->sum_in_rank_order(&back, 1);
   if (back / double(batch_step_.size()) <= 0.5) return false;

@@ -1,0 +1,82 @@
+// Beyond the paper: what changes over a fit, as a function of the iteration i
+// of n. The paper trains at a fixed M with step decays of the learning rate
+// ("step", kept as `--schedule step`). The default "ramp" spends the start of
+// the run, when phi is far from the surface and a coarse gradient is as good
+// as a fine one, on cheap steps: M starts at a fraction of its final value and
+// grows to it in a few equal levels (each level change reallocates the tape
+// once, so a step within a level allocates nothing). The learning rate keeps
+// the step decays; a short linear warm-up is optional. M depends on i and n
+// only, so a resumed run (the schedule is in its settings) and every MPI rank
+// (all at the same i) draw the same M. The measurements behind the defaults
+// are in docs/results.md ("Quality against time").
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "engine/adam.h"
+#include "engine/block.h"
+
+namespace jsa {
+
+struct ScheduleOptions {
+  // "ramp" (default) or "step" (M fixed, the paper's and the default before the ramp).
+  std::string kind = "ramp";
+  double points_start = 0.25;  // ramp: M at the start, as a fraction of the final M
+  double ramp_until = 0.75;    // ramp: fraction of the run by which M is final (the first decay)
+  int levels = 4;              // ramp: M grows in this many equal steps
+  double warmup = 0;           // fraction of the run over which lr rises linearly from lr/10
+};
+
+// The work of a step that does not grow with M, in points' worth (L_rep over
+// the K means, Adam, the lower GEMM rate of the small first levels): an
+// estimate, used only to turn the ramp into a cost (scheduled_cost_ratio).
+constexpr double kStepOverheadPoints = 250;
+
+// M at iteration i of n: `points` under "step"; under "ramp" level
+// l = floor(levels * i / (ramp_until n)) (capped at levels - 1) gets
+// points * (points_start + (1 - points_start) l / (levels - 1)), at least 16.
+inline Index scheduled_points(const ScheduleOptions& s, Index points, int64_t i, int64_t n) {
+  if (s.kind != "ramp" || s.levels <= 1 || s.points_start >= 1 || n <= 0) return points;
+  const double f = double(i) / (std::max(1e-9, s.ramp_until) * double(n));
+  const int l = std::min(s.levels - 1, int(std::floor(f * s.levels)));
+  const double frac = s.points_start + (1 - s.points_start) * double(l) / double(s.levels - 1);
+  return std::max<Index>(16, Index(std::llround(frac * double(points))));
+}
+
+// The learning rate at iteration i of n: the step decays (lr *= decay at each
+// fraction of decay_at), times a linear warm-up from lr/10 over the first
+// warmup * n iterations.
+inline double scheduled_lr(const ScheduleOptions& s, double lr, const std::vector<double>& decay_at,
+                           double decay, int64_t i, int64_t n) {
+  std::vector<int64_t> milestones;
+  for (double f : decay_at) milestones.push_back(int64_t(std::llround(f * double(n))));
+  double r = step_decay(lr, i, milestones, decay);
+  const double w = s.warmup * double(n);
+  if (w >= 1 && double(i) < w) r *= 0.1 + 0.9 * double(i) / w;
+  return r;
+}
+
+// The mean cost of the steps [i0, i1) of a run of n, with a step's cost
+// modelled as overhead + M_i (in points).
+inline double scheduled_mean_cost(const ScheduleOptions& s, Index points, double overhead,
+                                  int64_t i0, int64_t i1, int64_t n) {
+  if (i1 <= i0) return overhead + double(scheduled_points(s, points, i0, n));
+  double sum = 0;
+  for (int64_t i = i0; i < i1; ++i) sum += overhead + double(scheduled_points(s, points, i, n));
+  return sum / double(i1 - i0);
+}
+
+// The mean cost of a step over the run relative to a step at iteration 0. The
+// levels are fractions of the run, so any long n gives the ratio. Used to size
+// a run to a time budget from steps timed at its start, and the template start
+// of a collection to its share of the run's cost (model/tool/trainer.h).
+inline double scheduled_cost_ratio(const ScheduleOptions& s, Index points, double overhead) {
+  const int64_t n = 10000;
+  return scheduled_mean_cost(s, points, overhead, 0, n, n) /
+         scheduled_mean_cost(s, points, overhead, 0, 1, n);
+}
+
+}  // namespace jsa

@@ -1,0 +1,221 @@
+// The training schedule (model/tool/schedule.h): M's ramp in levels, the
+// learning rate's warm-up and step decays, the cost ratio that sizes a run to a
+// time budget, the schedule's place in a run's settings (config.json and the
+// checkpoint), and the trainer following it across level changes, a resume,
+// a fault's rewind and the template start of a collection.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <set>
+#include <string>
+
+#include "model/tool/fit_config.h"
+#include "model/tool/schedule.h"
+#include "model/tool/trainer.h"
+#include "test/sphere_pool.h"
+
+using jsa::Index;
+using jsa::ScheduleOptions;
+
+TEST_CASE("schedule: step keeps M fixed and decays lr at the fractions", "[schedule]") {
+  ScheduleOptions s;
+  s.kind = "step";
+  for (int64_t i : {0, 1, 499, 999}) CHECK(jsa::scheduled_points(s, 2500, i, 1000) == 2500);
+  CHECK(jsa::scheduled_lr(s, 1e-3, {0.75, 0.9}, 0.1, 0, 1000) == Approx(1e-3));
+  CHECK(jsa::scheduled_lr(s, 1e-3, {0.75, 0.9}, 0.1, 749, 1000) == Approx(1e-3));
+  CHECK(jsa::scheduled_lr(s, 1e-3, {0.75, 0.9}, 0.1, 750, 1000) == Approx(1e-4));
+  CHECK(jsa::scheduled_lr(s, 1e-3, {0.75, 0.9}, 0.1, 900, 1000) == Approx(1e-5));
+  CHECK(jsa::scheduled_cost_ratio(s, 2500, 250) == Approx(1.0));
+}
+
+TEST_CASE("schedule: ramp grows M in equal levels to its final value by ramp_until", "[schedule]") {
+  ScheduleOptions s;
+  s.kind = "ramp";
+  s.points_start = 0.25;
+  s.ramp_until = 0.5;
+  s.levels = 4;
+  const int64_t n = 1000;
+  CHECK(jsa::scheduled_points(s, 2500, 0, n) == 625);
+  CHECK(jsa::scheduled_points(s, 2500, 124, n) == 625);
+  CHECK(jsa::scheduled_points(s, 2500, 125, n) == 1250);
+  CHECK(jsa::scheduled_points(s, 2500, 374, n) == 1875);
+  CHECK(jsa::scheduled_points(s, 2500, 375, n) == 2500);
+  CHECK(jsa::scheduled_points(s, 2500, 999, n) == 2500);
+  std::set<Index> seen;
+  Index last = 0;
+  for (int64_t i = 0; i < n; ++i) {
+    const Index m = jsa::scheduled_points(s, 2500, i, n);
+    CHECK(m >= last);  // never shrinks: each level reallocates the tape once
+    last = m;
+    seen.insert(m);
+  }
+  CHECK(seen.size() == 4);
+  // Mean step cost over the run, (overhead + M_i) against overhead + M_0:
+  // levels of 1/8 of the run each at 625..2500, then 2500 for half the run.
+  const double c = 250;
+  const double expected = ((c + 625) + (c + 1250) + (c + 1875) + 5 * (c + 2500)) / 8 / (c + 625);
+  CHECK(jsa::scheduled_cost_ratio(s, 2500, c) == Approx(expected).epsilon(1e-3));
+  // Timed steps that straddle a level change (a short --iters under --minutes).
+  CHECK(jsa::scheduled_mean_cost(s, 2500, c, 0, 125, n) == Approx(c + 625));
+  CHECK(jsa::scheduled_mean_cost(s, 2500, c, 120, 130, n) == Approx(c + (625 + 1250) / 2.0));
+  // Never below 16 points.
+  s.points_start = 0.001;
+  CHECK(jsa::scheduled_points(s, 100, 0, n) == 16);
+}
+
+TEST_CASE("schedule: the warm-up rises linearly from lr/10", "[schedule]") {
+  ScheduleOptions s;
+  s.warmup = 0.1;
+  CHECK(jsa::scheduled_lr(s, 1e-3, {0.75}, 0.1, 0, 1000) == Approx(1e-4));
+  CHECK(jsa::scheduled_lr(s, 1e-3, {0.75}, 0.1, 50, 1000) == Approx(5.5e-4));
+  CHECK(jsa::scheduled_lr(s, 1e-3, {0.75}, 0.1, 100, 1000) == Approx(1e-3));
+  CHECK(jsa::scheduled_lr(s, 1e-3, {0.75}, 0.1, 800, 1000) == Approx(1e-4));
+}
+
+TEST_CASE("schedule: stored in the run's settings, older runs read as step",
+          "[schedule][fit_config]") {
+  jsa::FitOptions o;
+  CHECK(o.schedule.kind == "ramp");
+  CHECK(jsa::paper_fit_options().schedule.kind == "step");
+  o.schedule.points_start = 0.4;
+  o.schedule.ramp_until = 0.6;
+  o.schedule.levels = 3;
+  o.schedule.warmup = 0.05;
+  const std::string text = jsa::fit_options_to_json(o, -1);
+  const jsa::FitOptions back = jsa::fit_options_from_json(text, "x");
+  CHECK(back.schedule.kind == "ramp");
+  CHECK(back.schedule.points_start == 0.4);
+  CHECK(back.schedule.ramp_until == 0.6);
+  CHECK(back.schedule.levels == 3);
+  CHECK(back.schedule.warmup == 0.05);
+  std::string old = text;
+  const auto at = old.find(",\"schedule\":");
+  REQUIRE(at != std::string::npos);
+  old.erase(at, old.find('}', at) + 1 - at);
+  CHECK(jsa::fit_options_from_json(old, "old").schedule.kind == "step");
+  std::string bad = text;
+  bad.replace(bad.find("\"ramp\""), 6, "\"cosine\"");
+  CHECK_THROWS_WITH(jsa::fit_options_from_json(bad, "run/model.ckpt"),
+                    Catch::Contains("run/model.ckpt") && Catch::Contains("schedule.kind"));
+}
+
+TEST_CASE("schedule: the trainer draws the scheduled M targets, across a level change",
+          "[schedule][trainer]") {
+  jsa::FitOptions o;
+  o.atlas.gaussians = 128;
+  o.atlas.width = 16;
+  o.atlas.hidden_layers = 2;
+  o.points = 128;
+  o.iterations = 8;
+  o.schedule.points_start = 0.5;
+  o.schedule.ramp_until = 0.5;
+  o.schedule.levels = 2;
+  jsa::Trainer t(o, test_support::sphere_pool(2000, 1));
+  for (int i = 0; i < 8; ++i) {
+    CHECK(t.points() == (i < 2 ? 64 : 128));
+    t.step();
+    CHECK(std::isfinite(t.last().total));
+  }
+  CHECK(t.iteration() == 8);
+}
+
+namespace {
+
+// A ramp of two levels over the first half of 8 iterations: M = 64 for
+// iterations 0 and 1, then 128.
+jsa::FitOptions two_level_options() {
+  jsa::FitOptions o;
+  o.atlas.gaussians = 128;
+  o.atlas.width = 16;
+  o.atlas.hidden_layers = 2;
+  o.points = 128;
+  o.iterations = 8;
+  o.threads = 1;
+  o.schedule.kind = "ramp";
+  o.schedule.points_start = 0.5;
+  o.schedule.ramp_until = 0.5;
+  o.schedule.levels = 2;
+  return o;
+}
+
+}  // namespace
+
+TEST_CASE("schedule: a run resumed before a level change follows the uninterrupted one",
+          "[schedule][trainer]") {
+  const jsa::Block<double> pool = test_support::sphere_pool(2000, 1);
+  jsa::Trainer straight(two_level_options(), pool);
+  std::vector<double> expected;
+  while (!straight.finished()) {
+    straight.step();
+    expected.push_back(straight.last().total);
+  }
+  jsa::Trainer first(two_level_options(), pool);
+  first.step();
+  // The settings as a checkpoint stores them, read back: the schedule with them.
+  const jsa::FitOptions stored =
+      jsa::fit_options_from_json(jsa::fit_options_to_json(first.options()), "settings");
+  jsa::Trainer second(stored, pool);
+  second.load_state(first.save_state(), "state");
+  CHECK(second.points() == 64);
+  for (size_t i = 1; i < expected.size(); ++i) {
+    second.step();
+    CHECK(second.last().total == expected[i]);
+  }
+  CHECK(second.points() == 128);
+}
+
+TEST_CASE("schedule: a fault rewinds M with the iteration", "[schedule][trainer]") {
+  const jsa::Block<double> pool = test_support::sphere_pool(2000, 1);
+  jsa::Trainer t(two_level_options(), pool);
+  for (int i = 0; i < 3; ++i) t.step();
+  CHECK(t.points() == 128);
+  t.inject_faults(3, 1);
+  t.step();  // back to the snapshot of iteration 0, in the first level
+  CHECK(t.iteration() == 0);
+  CHECK(t.points() == 64);
+  for (int i = 0; i < 3; ++i) {
+    t.step();
+    CHECK(std::isfinite(t.last().total));
+  }
+  CHECK(t.points() == 128);
+}
+
+TEST_CASE("schedule: the template start takes the first level and its share of the ramp's cost",
+          "[schedule][trainer]") {
+  jsa::FitOptions o = two_level_options();
+  o.atlas.code_size = 4;
+  o.template_steps = 3;
+  const std::vector<jsa::Block<double>> pools = {test_support::sphere_pool(2000, 1),
+                                                 test_support::sphere_pool(2000, 2)};
+  jsa::Trainer t(o, pools);
+  t.train_template(3);
+  CHECK(t.template_done() == 3);
+  CHECK(t.iteration() == 0);  // the template does not count against the schedule
+  CHECK(t.points() == 64);
+  t.finish_template();
+  for (int i = 0; i < 8; ++i) t.step();
+  CHECK(t.points() == 128);
+  CHECK(std::isfinite(t.last().total));
+  // template_steps -1: share / (1 - share) x iterations x N single-shape steps,
+  // times the ramp's mean cost relative to its first level (1 at a fixed M).
+  o.template_steps = -1;
+  o.template_share = 0.3;
+  o.iterations = 1000;
+  const double ratio = jsa::scheduled_cost_ratio(o.schedule, o.points, jsa::kStepOverheadPoints);
+  CHECK(ratio > 1);
+  CHECK(jsa::Trainer::template_steps_for(o, 1000, 2) == std::llround(0.3 / 0.7 * 1000 * 2 * ratio));
+  o.schedule.kind = "step";
+  CHECK(jsa::Trainer::template_steps_for(o, 1000, 2) == std::llround(0.3 / 0.7 * 1000 * 2));
+}
+
+TEST_CASE("schedule: out-of-range settings are refused naming the setting", "[schedule][trainer]") {
+  const jsa::Block<double> pool = test_support::sphere_pool(200, 1);
+  jsa::FitOptions o = two_level_options();
+  o.schedule.kind = "cosine";
+  CHECK_THROWS_WITH(jsa::Trainer(o, pool), "schedule.kind must be ramp or step");
+  o = two_level_options();
+  o.schedule.points_start = 0;
+  CHECK_THROWS_WITH(jsa::Trainer(o, pool), "schedule.points_start must be in (0, 1]");
+  o = two_level_options();
+  o.schedule.levels = 0;
+  CHECK_THROWS_WITH(jsa::Trainer(o, pool), "schedule.levels must be in [1, 1000]");
+}
