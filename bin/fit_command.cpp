@@ -50,6 +50,9 @@ struct FitArgs {
   int64_t stop_at = 0;  // > 0: stop after this iteration with a checkpoint (continue with --resume)
   bool quiet = false;
   int64_t inject_fault_at = -1;  // tests only: one NaN loss at this iteration
+  // Whether --iters and --schedule were given: collections and --preset paper
+  // have defaults of their own (kFixedScheduleIterations in model/tool/trainer.h).
+  bool iters_given = false, schedule_given = false;
 };
 
 std::string format_duration(double seconds) {
@@ -84,7 +87,12 @@ Trainer make_trainer(const FitOptions& o, const std::vector<Block<double>>& pool
       {"template_steps", "--template-steps"},
       {"template_share", "--template-share"},
       {"chart_from", "--chart-from"},
-      {"code_lr_scale", "--code-lr-scale"}};
+      {"code_lr_scale", "--code-lr-scale"},
+      {"schedule.kind", "--schedule"},
+      {"schedule.points_start", "--points-start"},
+      {"schedule.ramp_until", "--ramp-until"},
+      {"schedule.levels", "--ramp-levels"},
+      {"schedule.warmup", "--warmup"}};
   try {
     return Trainer(o, pools, team);
   } catch (const InputError& e) {
@@ -151,6 +159,12 @@ void run_fit(FitArgs& a, Team& team) {
     if (a.no_distribution) o.components.distribution = false;
     if (a.no_chart) o.components.chart = false;
     if (a.no_isometry) o.components.isometry = false;
+    // The ramp and its length were measured on single shapes (docs/results.md);
+    // collections and the paper's sizes keep M fixed for 5000 steps, the
+    // default before the ramp, unless told otherwise.
+    const bool fixed_m = inputs.size() > 1 || !a.preset.empty();
+    if (fixed_m && !a.schedule_given) o.schedule.kind = "step";
+    if (fixed_m && !a.iters_given) o.iterations = kFixedScheduleIterations;
   }
   if (a.threads >= 0) o.threads = a.threads;
   set_threads(o.threads);
@@ -288,10 +302,13 @@ void run_fit(FitArgs& a, Team& team) {
     restore_trainer(trainer, resumed, a.resume);
     log = read_loss_log(dir + "/losses.csv", trainer.iteration(), trainer.faults());
   }
+  const Index first_points = scheduled_points(o.schedule, o.points, 0, o.iterations);
   if (!a.quiet)
     std::cerr << "fit: "
               << (inputs.size() == 1 ? inputs[0] : std::to_string(inputs.size()) + " shapes")
               << " -> " << dir << "  (" << o.iterations << " iterations, M = " << o.points
+              << (first_points < o.points ? " ramped from " + std::to_string(first_points)
+                                          : std::string())
               << ", K = " << o.atlas.gaussians << ", MLP " << o.atlas.hidden_layers << "x"
               << o.atlas.width << ", " << max_threads() << " threads"
               << (many ? " on each of " + std::to_string(team.size()) + " MPI ranks"
@@ -429,9 +446,19 @@ void run_fit(FitArgs& a, Team& team) {
   // learning-rate schedule) to what fits. The first iterations allocate the
   // tape and warm the caches, so they are left out of the timing. The length is
   // recorded in the checkpoint, so a resumed run follows the same schedule.
+  // Under the ramp the timed steps are the cheap ones of its first level: the
+  // later, larger steps are counted in by the schedule's cost model
+  // (model/tool/schedule.h: a step costs kStepOverheadPoints + M; an estimate,
+  // so a budget may end a little short or long).
   const int64_t warmup = 5, probe = 20;
   auto probe_start = start;
   bool sized = !(a.minutes > 0) || resuming;
+  if (!sized && o.iterations < first + warmup + probe) {
+    // Too short to be timed (the loop below would wait for iteration 25
+    // forever): the timed steps run as those of a default-length run.
+    o.iterations = FitOptions().iterations;
+    trainer.set_iterations(o.iterations);
+  }
   while (!trainer.finished() || !sized) {
     if (!sized && trainer.iteration() - first == warmup) probe_start = clock::now();
     if (!sized && trainer.iteration() - first == warmup + probe) {
@@ -439,8 +466,14 @@ void run_fit(FitArgs& a, Team& team) {
       const double per = std::chrono::duration<double>(now - probe_start).count() / double(probe);
       const double left =
           a.minutes * 60.0 - wrap_seconds - std::chrono::duration<double>(now - start).count();
-      const int64_t n = int64_t(
-          rank0_value(double(warmup + probe + std::max<int64_t>(1, int64_t(left / per * 0.97)))));
+      // Seconds per point of work in the timed steps, then the mean step of a whole run.
+      const double timed_cost =
+          scheduled_mean_cost(o.schedule, o.points, kStepOverheadPoints, first + warmup,
+                              first + warmup + probe, o.iterations);
+      const double mean_step =
+          per / timed_cost * scheduled_run_cost(o.schedule, o.points, kStepOverheadPoints);
+      const int64_t n = int64_t(rank0_value(
+          double(warmup + probe + std::max<int64_t>(1, int64_t(left / mean_step * 0.97)))));
       trainer.set_iterations(n);
       o.iterations = n;
       sized = true;
@@ -535,7 +568,9 @@ void add_fit(CLI::App& app) {
   c->add_option("-o,--out", a->out_dir, "Output directory (created if needed)");
   c->add_option("--resume", a->resume,
                 "Continue the run in DIR from its model.ckpt (settings come from the checkpoint)");
-  c->add_option("--iters", o.iterations, "Training iterations")
+  c->add_option("--iters", o.iterations,
+                "Training iterations (collections and --preset paper: " +
+                    std::to_string(kFixedScheduleIterations) + ")")
       ->capture_default_str()
       ->check(CLI::Range(int64_t(0), int64_t(100000000)));
   c->add_option("--points,-M", o.points, "M: points sampled on P and on the shape per iteration")
@@ -566,9 +601,33 @@ void add_fit(CLI::App& app) {
   c->add_option("--decay-at", o.decay_at, "Fractions of --iters where the learning rate decays")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
+  c->add_option("--schedule", o.schedule.kind,
+                "ramp: M grows from --points-start x M to M by --ramp-until of the run; step: M "
+                "fixed (the paper's, and the default for collections and --preset paper); both "
+                "decay lr at --decay-at")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"ramp", "step"}));
+  c->add_option("--points-start", o.schedule.points_start,
+                "ramp: M at the start, as a fraction of --points")
+      ->capture_default_str()
+      ->check(CLI::Range(0.001, 1.0))
+      ->check(kFinite);
+  c->add_option("--ramp-until", o.schedule.ramp_until,
+                "ramp: fraction of the run by which M reaches --points")
+      ->capture_default_str()
+      ->check(CLI::Range(0.001, 1.0))
+      ->check(kFinite);
+  c->add_option("--ramp-levels", o.schedule.levels, "ramp: M grows in this many equal steps")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000));
+  c->add_option("--warmup", o.schedule.warmup,
+                "Fraction of the run over which lr rises linearly from lr/10 (0: none)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0))
+      ->check(kFinite);
   c->add_option("--minutes", a->minutes,
                 "Time budget: after 5 warm-up and 20 timed iterations, set --iters to fill it (the "
-                "schedule follows)")
+                "schedule follows; the ramp's later, larger steps counted in)")
       ->check(CLI::Range(0.01, 100000.0));
   c->add_option("--stop-at", a->stop_at,
                 "Stop after this iteration with a checkpoint, exit 0; continue with --resume (job "
@@ -705,7 +764,9 @@ void add_fit(CLI::App& app) {
   // Hidden (no group): lets the CLI tests see a NaN/Inf recovery end to end.
   c->add_option("--inject-fault-at", a->inject_fault_at, "Tests: one NaN loss at this iteration")
       ->group("");
-  c->callback([a]() {
+  c->callback([a, c]() {
+    a->iters_given = c->count("--iters") > 0;
+    a->schedule_given = c->count("--schedule") > 0;
     std::unique_ptr<Team> team = join_team();
     if (team->size() == 1) return run_fit(*a, *team);
     try {

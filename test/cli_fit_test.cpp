@@ -6,6 +6,7 @@
 
 #include <catch2/catch.hpp>
 #include <csignal>
+#include <nlohmann/json.hpp>
 #include <thread>
 
 #include "io/geometry/builtin_shapes.h"
@@ -231,4 +232,45 @@ TEST_CASE("cli: the starting wrap is reported, and Ctrl-C during it writes no ch
   CHECK(r.output.find("exit=130") != std::string::npos);
   CHECK(r.output.find("interrupted while wrapping") != std::string::npos);
   CHECK_FALSE(fs::exists(stopped + "/model.ckpt"));
+}
+
+TEST_CASE("cli: the schedule's flags are saved, collections keep M fixed, a short budget is timed",
+          "[cli][schedule]") {
+  const std::string dir = fresh_dir("schedule");
+  Result r = run("fit builtin:sphere -o " + dir +
+                 " --iters 8 --points-start 0.5 --ramp-until 0.5 --ramp-levels 2 --warmup 0.25" +
+                 kSmall.substr(0, kSmall.size() - 3));  // without -q: the first line says M
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  CHECK(r.output.find("M = 200 ramped from 100") != std::string::npos);
+  auto settings = [](const std::string& run) {
+    return nlohmann::json::parse(read_text(run + "/config.json"))["settings"];
+  };
+  const nlohmann::json single = settings(dir);
+  CHECK(single["iterations"] == 8);
+  CHECK(single["schedule"]["kind"] == "ramp");  // the single-shape default
+  CHECK(single["schedule"]["points_start"] == 0.5);
+  CHECK(single["schedule"]["ramp_until"] == 0.5);
+  CHECK(single["schedule"]["levels"] == 2);
+  CHECK(single["schedule"]["warmup"] == 0.25);
+  // A collection without --schedule or --iters: M fixed for 5000 steps.
+  r = run("fit builtin:sphere builtin:torus -o " + dir + "_pair --stop-at 1 --template-steps 0" +
+          kSmall);
+  REQUIRE(r.code == 0);
+  CHECK(settings(dir + "_pair")["schedule"]["kind"] == "step");
+  CHECK(settings(dir + "_pair")["iterations"] == 5000);
+  r = run("fit builtin:sphere builtin:torus -o " + dir +
+          "_pair_ramp --stop-at 1 --template-steps 0 --schedule ramp --iters 30" + kSmall);
+  REQUIRE(r.code == 0);
+  CHECK(settings(dir + "_pair_ramp")["schedule"]["kind"] == "ramp");
+  CHECK(settings(dir + "_pair_ramp")["iterations"] == 30);
+  CHECK(run("fit builtin:sphere -o " + dir + "_bad --schedule cosine" + kSmall).code == 2);
+  CHECK(run("fit builtin:sphere -o " + dir + "_bad --points-start 0" + kSmall).code == 2);
+  CHECK(run("fit builtin:sphere -o " + dir + "_bad --ramp-levels 0" + kSmall).code == 2);
+  // A budget with fewer iterations than the 25 timed ones (the loop used to
+  // wait for iteration 25 forever): the timed steps run, then the budget sets --iters.
+  r = run("fit builtin:sphere -o " + dir + "_budget --iters 3 --minutes 0.01" + kSmall);
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  CHECK(settings(dir + "_budget")["iterations"] > 25);
 }
