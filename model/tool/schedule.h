@@ -69,14 +69,20 @@ inline double scheduled_mean_cost(const ScheduleOptions& s, Index points, double
   return sum / double(i1 - i0);
 }
 
-// The mean cost of a step over the run relative to a step at iteration 0. The
-// levels are fractions of the run, so any long n gives the ratio. Used to size
-// a run to a time budget from steps timed at its start, and the template start
-// of a collection to its share of the run's cost (model/tool/trainer.h).
-inline double scheduled_cost_ratio(const ScheduleOptions& s, Index points, double overhead) {
+// The mean cost of a step over a whole run: the levels are fractions of the
+// run, so any long n gives it. Used to size a run to a time budget from steps
+// timed at its start (`jsatlas fit --minutes`).
+inline double scheduled_run_cost(const ScheduleOptions& s, Index points, double overhead) {
   const int64_t n = 10000;
-  return scheduled_mean_cost(s, points, overhead, 0, n, n) /
-         scheduled_mean_cost(s, points, overhead, 0, 1, n);
+  return scheduled_mean_cost(s, points, overhead, 0, n, n);
+}
+
+// The same relative to a step at iteration 0: how much dearer the run's mean
+// step is than its first. Sizes the template start of a collection to its
+// share of the run's cost (model/tool/trainer.h).
+inline double scheduled_cost_ratio(const ScheduleOptions& s, Index points, double overhead) {
+  return scheduled_run_cost(s, points, overhead) /
+         (overhead + double(scheduled_points(s, points, 0, 10000)));
 }
 
 }  // namespace jsa
