@@ -5,7 +5,8 @@
 // defaults, not the paper's (docs/method.md, "Defaults"): alpha = 0.08, softplus
 // beta = 40, lambda_cycle = 0.1 (the other lambdas the paper's), the dense L_6D
 // over the whole pool, the orientation check every 100 steps, lr x 0.1 at 75% and
-// 90% of the iterations. The library never prints: the loop below reports
+// 90% of the iterations, M ramped from a quarter of its value in four levels
+// until 75% (model/tool/schedule.h). The library never prints: the loop below reports
 // progress itself. Exits non-zero if L_6D (Eq. 7) does not drop tenfold.
 #include <cmath>
 #include <cstdio>
