@@ -6,6 +6,9 @@
 #   determinism  mpirun -np 2 a second time: bit-identical to np2's checkpoint
 #   resume       -np 2 stopped at iteration 6, resumed with -np 3: within BOUND
 #   batch        --batch-shapes 3 on 1 process and on 2 ranks: within BOUND
+#   ramp         --schedule ramp (M 16, 32, 48, 64 over the first 9 of 12 steps) on 2
+#                ranks, and on 2 ranks stopped at 3 (where M changes) and resumed on
+#                1: within BOUND of the 1-process ramp (every rank draws the same M)
 #   errors       more ranks than shapes, --wrap or --template-steps over 2 ranks: a one-line
 #                error, the job ends non-zero
 # Usage: run_tests.sh MODE JSATLAS COMPARE MPIEXEC WORKDIR BOUND
@@ -53,6 +56,13 @@ case "$mode" in
     rm -rf resumed1 && run 3 "${fit[@]}" --stop-at 9 -o resumed1
     run 1 fit --resume resumed1 -q
     "$compare" one/model.ckpt resumed1/model.ckpt "$bound" ;;
+  ramp)
+    rm -rf one_ramp && run 1 "${fit[@]}" --schedule ramp -o one_ramp
+    rm -rf np2_ramp && run 2 "${fit[@]}" --schedule ramp -o np2_ramp
+    "$compare" one_ramp/model.ckpt np2_ramp/model.ckpt "$bound"
+    rm -rf ramp_resumed && run 2 "${fit[@]}" --schedule ramp --stop-at 3 -o ramp_resumed
+    run 1 fit --resume ramp_resumed -q
+    "$compare" one_ramp/model.ckpt ramp_resumed/model.ckpt "$bound" ;;
   batch)
     rm -rf np2_batch && run 2 "${fit[@]}" --batch-shapes 3 -o np2_batch
     "$compare" one_batch/model.ckpt np2_batch/model.ckpt "$bound" ;;
