@@ -254,13 +254,14 @@ TEST_CASE("cli: the schedule's flags are saved, collections keep M fixed, a shor
   CHECK(single["schedule"]["levels"] == 2);
   CHECK(single["schedule"]["warmup"] == 0.25);
   // A collection without --schedule or --iters: M fixed for 5000 steps.
-  r = run("fit builtin:sphere builtin:torus -o " + dir + "_pair --stop-at 1 --template-steps 0" +
-          kSmall);
+  r = run("fit builtin:sphere builtin:torus -o " + dir +
+          "_pair --stop-at 1 --template-steps 0 --no-align" + kSmall);
   REQUIRE(r.code == 0);
   CHECK(settings(dir + "_pair")["schedule"]["kind"] == "step");
   CHECK(settings(dir + "_pair")["iterations"] == 5000);
   r = run("fit builtin:sphere builtin:torus -o " + dir +
-          "_pair_ramp --stop-at 1 --template-steps 0 --schedule ramp --iters 30" + kSmall);
+          "_pair_ramp --stop-at 1 --template-steps 0 --no-align --schedule ramp --iters 30" +
+          kSmall);
   REQUIRE(r.code == 0);
   CHECK(settings(dir + "_pair_ramp")["schedule"]["kind"] == "ramp");
   CHECK(settings(dir + "_pair_ramp")["iterations"] == 30);
