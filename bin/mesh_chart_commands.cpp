@@ -43,6 +43,26 @@ int checked_shape(const LoadedRun& r, int shape) {
   return shape;
 }
 
+// The options `mesh` and `chart` share: threads, shape, and the texture the UVs are for.
+template <class Args>
+void add_shared_options(CLI::App* c, Args& a, const std::string& padding_help) {
+  c->add_option("--threads", a.threads, "Threads (0: all cores)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1024));
+  c->add_option("--shape", a.shape, "Which shape of a collection (0-based)")->capture_default_str();
+  c->add_option("--texture", a.options.texture,
+                "An image for the MTL instead of the built-in colour chart (a texture made for one "
+                "shape of a collection fits every shape)");
+  c->add_option("--texture-size", a.options.texture_size,
+                "Texels per side of the texture the UVs are for")
+      ->capture_default_str()
+      ->check(CLI::Range(16, 65536));
+  c->add_option("--padding", a.options.padding, padding_help)
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1024.0));
+  c->add_flag("-q,--quiet", a.options.quiet, "No report on the terminal");
+}
+
 }  // namespace
 
 void add_mesh(CLI::App& app) {
@@ -60,23 +80,7 @@ void add_mesh(CLI::App& app) {
   c->add_option("--threshold", a->options.threshold, "Domain = {P >= t * median of P at the means}")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 100.0));
-  c->add_option("--threads", a->threads, "Threads (0: all cores)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 1024));
-  c->add_option("--shape", a->shape, "Which shape of a collection (0-based)")
-      ->capture_default_str();
-  c->add_option("--texture", a->options.texture,
-                "An image for the MTL instead of the built-in colour chart (a texture made for one "
-                "shape of a collection fits every shape)");
-  c->add_option("--texture-size", a->options.texture_size,
-                "Texels per side of the texture the UVs are for")
-      ->capture_default_str()
-      ->check(CLI::Range(16, 65536));
-  c->add_option("--padding", a->options.padding,
-                "Texels between the layout and the texture's border")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1024.0));
-  c->add_flag("-q,--quiet", a->options.quiet, "No report on the terminal");
+  add_shared_options(c, *a, "Texels between the layout and the texture's border");
   c->callback([a]() {
     set_threads(a->threads);
     LoadedRun r = load_run(a->run);
@@ -103,27 +107,11 @@ void add_chart(CLI::App& app) {
       "--no-pack", [a](std::int64_t) { a->options.pack = false; },
       "Keep each valid chart where psi puts it (the shared-domain layout, for texture transfer "
       "across a collection; charts may overlap each other)");
-  c->add_option("--texture-size", a->options.texture_size,
-                "Texels per side of the texture the UVs are for")
-      ->capture_default_str()
-      ->check(CLI::Range(16, 65536));
-  c->add_option("--padding", a->options.padding,
-                "Texels between packed charts and along the border")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1024.0));
   c->add_option("--torn-ratio", a->options.torn_ratio,
                 "A UV edge this many times longer than its 3D edge (areas equalised) is torn")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 1e6));
-  c->add_option("--threads", a->threads, "Threads (0: all cores)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 1024));
-  c->add_option("--shape", a->shape, "Which shape of a collection (0-based)")
-      ->capture_default_str();
-  c->add_option("--texture", a->options.texture,
-                "An image for the MTL instead of the built-in colour chart (a texture made for one "
-                "shape of a collection fits every shape)");
-  c->add_flag("-q,--quiet", a->options.quiet, "No report on the terminal");
+  add_shared_options(c, *a, "Texels between packed charts and along the border");
   c->callback([a]() {
     set_threads(a->threads);
     LoadedRun r = load_run(a->run);
