@@ -7,6 +7,7 @@
 //     random offset; NAME.vts beside NAME.obj is copied with its x y z turned
 //     the same way (the vertex indices stay valid: the lines keep their order).
 //     DIR/applied_rotations.json lists A_i (rows: x' = x A_i + t_i).
+//   bench_rotate_shapes align [--trim 1,0.7,0.5] [--seed S] A.obj B.obj ...   (the pose step alone)
 //   bench_rotate_shapes compare --applied DIR/applied_rotations.json --found RUN/rotations.json
 //                               [--reference RUN0/rotations.json]
 //     the angle between the rotation the fit found for each copy and the one
@@ -28,6 +29,7 @@
 #include "engine/rng.h"
 #include "io/atomic_write.h"
 #include "io/geometry/rigid_align.h"
+#include "model/tool/shape_input.h"
 
 namespace {
 
@@ -114,6 +116,18 @@ int main(int argc, char** argv) {
   cmp->add_option("--applied", applied)->required();
   cmp->add_option("--found", found)->required();
   cmp->add_option("--reference", reference);
+  CLI::App* al = app.add_subcommand(
+      "align",
+      "The pose step alone (best candidate, no keep-the-input rule) onto the first shape, "
+      "for each --trim: the angle each shape is turned by, its score and the runner-up's");
+  std::vector<double> trims{1.0};
+  al->add_option("--trim", trims,
+                 "Shares of the closest pairs kept, comma-separated (RigidAlignOptions::trim)")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->capture_default_str();
+  al->add_option("--seed", seed, "Seed of the surface samples")->capture_default_str();
+  al->add_option("inputs", inputs)->required();
   app.require_subcommand(1);
   CLI11_PARSE(app, argc, argv);
   try {
@@ -142,6 +156,22 @@ int main(int argc, char** argv) {
           {"seed", seed}, {"convention", "rows: x' = x * rotation + offset"}, {"shapes", list}};
       jsa::write_file_atomically((fs::path(out_dir) / "applied_rotations.json").string(),
                                  [&](std::ostream& f) { f << j.dump(2) << "\n"; });
+    } else if (*al) {
+      std::vector<jsa::RunInput> shapes;
+      for (const std::string& in : inputs) shapes.push_back(jsa::load_run_input(in, 5000, seed));
+      for (const double trim : trims) {
+        std::printf("trim %.2f:\n", trim);
+        for (size_t i = 1; i < shapes.size(); ++i) {
+          jsa::RigidAlignOptions o;
+          o.keep_input = 0;
+          o.trim = trim;
+          const jsa::RigidAlignment r =
+              jsa::rigid_align(shapes[i].pool.leftCols(3), shapes[0].pool.leftCols(3), o);
+          std::printf("  %s: %.1f deg, score %.2f, runner-up %.2f (x 1e-4, margin %.2f)\n",
+                      fs::path(inputs[i]).filename().c_str(), r.angle_degrees(), 1e4 * r.chamfer,
+                      1e4 * r.runner_up, r.runner_up / r.chamfer);
+        }
+      }
     } else {
       const auto a = read_rotations(applied, "shapes", "rotation");
       const auto r = read_rotations(found, "shapes", "rotation");

@@ -123,3 +123,38 @@ TEST_CASE("a shape already in the pose of the first keeps it", "[model][rigid_al
   CHECK(r.input_chamfer <= 1.25 * r.chamfer);
   CHECK(r.angle_degrees() < 5.0);
 }
+
+TEST_CASE("trimmed ICP turns back a shape whose limb moved", "[model][rigid_align]") {
+  // The lumpy body, and a copy whose bump ("limb": the points beyond x = 0.45)
+  // swung 70 degrees about the z axis through (0.45, 0, 0), then posed. The
+  // body still pins the pose; the limb's points have no partners near them.
+  const jsa::Block<double> fixed = lumpy(3000, 11);
+  jsa::Block<double> bent = lumpy(3000, 12);
+  const double c = std::cos(70 * M_PI / 180), s = std::sin(70 * M_PI / 180);
+  jsa::Index limb = 0;
+  for (jsa::Index i = 0; i < bent.rows(); ++i) {
+    if (bent(i, 0) <= 0.45) continue;
+    const double x = bent(i, 0) - 0.45, y = bent(i, 1);
+    bent(i, 0) = 0.45 + c * x - s * y;
+    bent(i, 1) = s * x + c * y;
+    ++limb;
+  }
+  REQUIRE(limb > 300);  // a limb, not a few points: 10-30% of the set
+  REQUIRE(limb < 1000);
+  jsa::Rng rng(21);
+  const Eigen::Matrix3d a = random_rotation(rng);
+  const jsa::Block<double> moving = bent * a;
+  jsa::RigidAlignOptions o;
+  o.keep_input = 0;
+  o.trim = 0.6;
+  const jsa::RigidAlignment r = jsa::rigid_align(moving, fixed, o);
+  INFO("limb points " << limb << ", applied " << jsa::rotation_angle_degrees(a) << " deg");
+  // The body's pose within 3 degrees (the limb would pull a plain fit off it).
+  CHECK(jsa::rotation_angle_degrees(r.rotation.transpose() * a.transpose()) < 3.0);
+  CHECK(r.rotation.determinant() == Approx(1).margin(1e-9));
+  // A trim outside (0, 1] is an error, not a silent plain fit.
+  o.trim = 0;
+  CHECK_THROWS(jsa::rigid_align(moving, fixed, o));
+  o.trim = 1.5;
+  CHECK_THROWS(jsa::rigid_align(moving, fixed, o));
+}

@@ -37,30 +37,56 @@ struct Sets {
   const Block<double>& fixed;
   const NearestIndex<double>& moving_index;
   const NearestIndex<double>& fixed_index;
+  double trim;  // RigidAlignOptions::trim
 };
 
-// Symmetric Chamfer of (moving R, fixed), and the Kabsch update from the same pairs.
+// The pairs one direction keeps: all of them, or the `trim` share closest.
+// Returns the mean squared distance over the kept pairs; keep[i] says which.
+double kept_pairs(const std::vector<double>& d2, double trim, std::vector<char>& keep) {
+  const size_t n = d2.size();
+  keep.assign(n, 1);
+  if (trim >= 1) {
+    double sum = 0;
+    for (double d : d2) sum += d;
+    return sum / double(n);
+  }
+  const size_t k = std::max<size_t>(1, size_t(trim * double(n)));
+  std::vector<double> sorted = d2;
+  std::nth_element(sorted.begin(), sorted.begin() + long(k - 1), sorted.end());
+  const double cut = sorted[k - 1];
+  // Ties at the cut are kept in index order, so exactly k pairs count.
+  size_t below = 0;
+  for (double d : d2) below += d < cut;
+  size_t at_cut = k - below;
+  double sum = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const bool in = d2[i] < cut || (d2[i] == cut && at_cut > 0 && at_cut--);
+    keep[i] = in;
+    if (in) sum += d2[i];
+  }
+  return sum / double(k);
+}
+
+// Symmetric (trimmed) Chamfer of (moving R, fixed), and the Kabsch update from
+// the same pairs.
 double chamfer_and_update(const Sets& s, const Eigen::Matrix3d& r, Eigen::Matrix3d* next) {
   std::vector<int> nn;
   std::vector<double> d2;
+  std::vector<char> keep;
   const Block<double> moved = s.moving * r;
   s.fixed_index.query(moved, nn, &d2);
-  double forward = 0;
+  const double forward = kept_pairs(d2, s.trim, keep);
   Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-  for (Index i = 0; i < moved.rows(); ++i) {
-    forward += d2[size_t(i)];
-    h += s.moving.row(i).transpose() * s.fixed.row(nn[size_t(i)]);
-  }
+  for (Index i = 0; i < moved.rows(); ++i)
+    if (keep[size_t(i)]) h += s.moving.row(i).transpose() * s.fixed.row(nn[size_t(i)]);
   // |x R - y| = |x - y R^T|: the fixed points' neighbours among the unmoved ones.
   const Block<double> back = s.fixed * r.transpose();
   s.moving_index.query(back, nn, &d2);
-  double backward = 0;
-  for (Index j = 0; j < back.rows(); ++j) {
-    backward += d2[size_t(j)];
-    h += s.moving.row(nn[size_t(j)]).transpose() * s.fixed.row(j);
-  }
+  const double backward = kept_pairs(d2, s.trim, keep);
+  for (Index j = 0; j < back.rows(); ++j)
+    if (keep[size_t(j)]) h += s.moving.row(nn[size_t(j)]).transpose() * s.fixed.row(j);
   if (next) *next = kabsch(h);
-  return forward / double(moved.rows()) + backward / double(back.rows());
+  return forward + backward;
 }
 
 }  // namespace
@@ -77,12 +103,13 @@ RigidAlignment rigid_align(const Block<double>& moving_all, const Block<double>&
   JSA_CHECK(moving_all.cols() == 3 && fixed_all.cols() == 3, "rigid_align takes N x 3 points");
   JSA_CHECK(moving_all.rows() >= 4 && fixed_all.rows() >= 4,
             "rigid_align needs at least 4 points per set");
-  JSA_CHECK(o.samples >= 4 && o.icp_iterations >= 0 && o.final_iterations >= 0,
+  JSA_CHECK(o.samples >= 4 && o.icp_iterations >= 0 && o.final_iterations >= 0 && o.trim > 0 &&
+                o.trim <= 1,
             "bad rigid_align options");
   const Block<double> moving = moving_all.topRows(std::min(o.samples, moving_all.rows()));
   const Block<double> fixed = fixed_all.topRows(std::min(o.samples, fixed_all.rows()));
   const NearestIndex<double> moving_index(moving), fixed_index(fixed);
-  const Sets sets{moving, fixed, moving_index, fixed_index};
+  const Sets sets{moving, fixed, moving_index, fixed_index, o.trim};
 
   Eigen::Matrix3d vm, vf;
   Eigen::Vector3d lm, lf;

@@ -37,6 +37,11 @@ struct RigidAlignOptions {
   // is within this factor of the best candidate's: a collection stored aligned
   // stays as it is unless another pose is clearly better (0: always the best).
   double keep_input = 1.25;
+  // The share of the closest pairs, each way, that the score and the ICP
+  // updates use (trimmed ICP); 1: every pair (the plain symmetric Chamfer).
+  // Articulated shapes (legs in other poses) spend most of a plain Chamfer on
+  // the limbs; a trimmed one is decided by the parts that do match.
+  double trim = 1.0;
 };
 
 struct RigidAlignment {
