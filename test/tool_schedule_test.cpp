@@ -98,26 +98,6 @@ TEST_CASE("schedule: stored in the run's settings, older runs read as step",
                     Catch::Contains("run/model.ckpt") && Catch::Contains("schedule.kind"));
 }
 
-TEST_CASE("schedule: the trainer draws the scheduled M targets, across a level change",
-          "[schedule][trainer]") {
-  jsa::FitOptions o;
-  o.atlas.gaussians = 128;
-  o.atlas.width = 16;
-  o.atlas.hidden_layers = 2;
-  o.points = 128;
-  o.iterations = 8;
-  o.schedule.points_start = 0.5;
-  o.schedule.ramp_until = 0.5;
-  o.schedule.levels = 2;
-  jsa::Trainer t(o, test_support::sphere_pool(2000, 1));
-  for (int i = 0; i < 8; ++i) {
-    CHECK(t.points() == (i < 2 ? 64 : 128));
-    t.step();
-    CHECK(std::isfinite(t.last().total));
-  }
-  CHECK(t.iteration() == 8);
-}
-
 namespace {
 
 // A ramp of two levels over the first half of 8 iterations: M = 64 for
@@ -138,6 +118,17 @@ jsa::FitOptions two_level_options() {
 }
 
 }  // namespace
+
+TEST_CASE("schedule: the trainer draws the scheduled M targets, across a level change",
+          "[schedule][trainer]") {
+  jsa::Trainer t(two_level_options(), test_support::sphere_pool(2000, 1));
+  for (int i = 0; i < 8; ++i) {
+    CHECK(t.points() == (i < 2 ? 64 : 128));
+    t.step();
+    CHECK(std::isfinite(t.last().total));
+  }
+  CHECK(t.iteration() == 8);
+}
 
 TEST_CASE("schedule: a run resumed before a level change follows the uninterrupted one",
           "[schedule][trainer]") {
