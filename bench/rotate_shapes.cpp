@@ -126,7 +126,12 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->allow_extra_args(false)
       ->capture_default_str();
+  double tie = jsa::RigidAlignOptions{}.tie;
+  al->add_option("--tie", tie, "RigidAlignOptions::tie (0: the lowest Chamfer only)")
+      ->capture_default_str();
   al->add_option("--seed", seed, "Seed of the surface samples")->capture_default_str();
+  al->add_option("--applied", applied,
+                 "applied_rotations.json of the inputs (rotate's): print each angle error");
   al->add_option("inputs", inputs)->required();
   app.require_subcommand(1);
   CLI11_PARSE(app, argc, argv);
@@ -159,17 +164,28 @@ int main(int argc, char** argv) {
     } else if (*al) {
       std::vector<jsa::RunInput> shapes;
       for (const std::string& in : inputs) shapes.push_back(jsa::load_run_input(in, 5000, seed));
+      std::vector<Eigen::Matrix3d> a;
+      if (!applied.empty()) a = read_rotations(applied, "shapes", "rotation");
+      if (!a.empty() && a.size() != shapes.size()) throw std::runtime_error("shape counts differ");
       for (const double trim : trims) {
         std::printf("trim %.2f:\n", trim);
         for (size_t i = 1; i < shapes.size(); ++i) {
           jsa::RigidAlignOptions o;
           o.keep_input = 0;
           o.trim = trim;
+          o.tie = tie;
           const jsa::RigidAlignment r =
               jsa::rigid_align(shapes[i].pool.leftCols(3), shapes[0].pool.leftCols(3), o);
-          std::printf("  %s: %.1f deg, score %.2f, runner-up %.2f (x 1e-4, margin %.2f)\n",
-                      fs::path(inputs[i]).filename().c_str(), r.angle_degrees(), 1e4 * r.chamfer,
-                      1e4 * r.runner_up, r.runner_up / r.chamfer);
+          std::printf(
+              "  %s: %.1f deg, score %.2f, runner-up %.2f (x 1e-4, margin %.2f), %d tied%s\n",
+              fs::path(inputs[i]).filename().c_str(), r.angle_degrees(), 1e4 * r.chamfer,
+              1e4 * r.runner_up, r.runner_up / r.chamfer, r.tied,
+              r.tie_broken ? ", tie broken by ball shares" : "");
+          // The stored shapes are taken as aligned: posed i goes onto posed 0 by A_i^T A_0.
+          if (!a.empty())
+            std::printf(
+                "    error %.1f deg\n",
+                jsa::rotation_angle_degrees(r.rotation.transpose() * a[i].transpose() * a[0]));
         }
       }
     } else {

@@ -89,6 +89,64 @@ double chamfer_and_update(const Sets& s, const Eigen::Matrix3d& r, Eigen::Matrix
   return forward + backward;
 }
 
+// Ball shares (RigidAlignOptions::tie): for every point, the fraction of its
+// set within each of ten radii, relative to the set's RMS radius. They do
+// not change under a rotation, and they tell a thick part (a wide cap in every
+// ball) from a thin or busy one (legs, antennae) that sits in the same place.
+Block<double> ball_shares(const Block<double>& p) {
+  constexpr std::array<double, 10> radii{0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.7, 0.9, 1.2};
+  const double rms = std::sqrt(p.rowwise().squaredNorm().mean());
+  std::array<double, radii.size()> r2;
+  for (size_t k = 0; k < radii.size(); ++k) r2[k] = radii[k] * radii[k] * rms * rms;
+  const Index n = p.rows();
+  Block<double> out(n, Index(radii.size()));
+#pragma omp parallel for schedule(static)
+  for (Index i = 0; i < n; ++i) {
+    std::array<Index, radii.size()> count{};
+    for (Index j = 0; j < n; ++j) {
+      const double d2 = (p.row(i) - p.row(j)).squaredNorm();
+      for (size_t k = 0; k < radii.size(); ++k) count[k] += d2 < r2[k];
+    }
+    for (size_t k = 0; k < radii.size(); ++k) out(i, Index(k)) = double(count[k]) / double(n);
+  }
+  return out;
+}
+
+// The mean L1 distance between the ball shares of nearest pairs, both ways, at
+// the pose r, each radius weighted by 1 / its mean share (so the small balls,
+// whose shares are small numbers, count as much as the large ones): small when
+// every part lands on a part that looks like it.
+double share_mismatch(const Sets& s, const Eigen::Matrix3d& r, const Block<double>& moving_shares,
+                      const Block<double>& fixed_shares) {
+  // Each radius counts alike: differences relative to the radius' mean share.
+  const Eigen::RowVectorXd w =
+      2.0 / (moving_shares.colwise().mean() + fixed_shares.colwise().mean()).array().max(1e-12);
+  std::vector<int> nn;
+  std::vector<double> d2;
+  std::vector<char> keep;
+  double sum = 0;
+  Index pairs = 0;
+  // The pairs the score keeps (RigidAlignOptions::trim), so a moved limb is
+  // left out here as it is from the Chamfer.
+  s.fixed_index.query(s.moving * r, nn, &d2);
+  kept_pairs(d2, s.trim, keep);
+  for (Index i = 0; i < s.moving.rows(); ++i)
+    if (keep[size_t(i)]) {
+      sum +=
+          (moving_shares.row(i) - fixed_shares.row(nn[size_t(i)])).cwiseAbs().cwiseProduct(w).sum();
+      ++pairs;
+    }
+  s.moving_index.query(s.fixed * r.transpose(), nn, &d2);
+  kept_pairs(d2, s.trim, keep);
+  for (Index j = 0; j < s.fixed.rows(); ++j)
+    if (keep[size_t(j)]) {
+      sum +=
+          (fixed_shares.row(j) - moving_shares.row(nn[size_t(j)])).cwiseAbs().cwiseProduct(w).sum();
+      ++pairs;
+    }
+  return sum / double(pairs);
+}
+
 }  // namespace
 
 double rotation_angle_degrees(const Eigen::Matrix3d& r) {
@@ -168,6 +226,31 @@ RigidAlignment rigid_align(const Block<double>& moving_all, const Block<double>&
   if (best != 0 && o.keep_input > 0 && scores[0] <= o.keep_input * scores[best]) {
     best = 0;
     out.kept_input = true;
+  } else if (o.tie > 0) {
+    // One representative (the lowest Chamfer) per distinct pose within `tie`.
+    std::vector<size_t> tied{best};
+    std::vector<size_t> order(scores.size());
+    for (size_t c = 0; c < order.size(); ++c) order[c] = c;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](size_t a, size_t b) { return scores[a] < scores[b]; });
+    for (size_t c : order) {
+      if (scores[c] > o.tie * scores[best]) break;
+      bool distinct = true;
+      for (size_t t : tied)
+        distinct = distinct && rotation_angle_degrees(refined[c].transpose() * refined[t]) > 10;
+      if (distinct) tied.push_back(c);
+    }
+    out.tied = int(tied.size());
+    if (tied.size() > 1) {
+      const Block<double> moving_shares = ball_shares(moving), fixed_shares = ball_shares(fixed);
+      double least = share_mismatch(sets, refined[best], moving_shares, fixed_shares);
+      const size_t lowest = best;
+      for (size_t t = 1; t < tied.size(); ++t) {
+        const double m = share_mismatch(sets, refined[tied[t]], moving_shares, fixed_shares);
+        if (m < least) least = m, best = tied[t];
+      }
+      out.tie_broken = best != lowest;
+    }
   }
   out.rotation = icp(refined[best], o.final_iterations);
   out.chamfer = chamfer_and_update(sets, out.rotation, nullptr);
