@@ -69,6 +69,7 @@ nlohmann::json stats_json(const ValidUvStats& s, bool packed) {
   j["boundary_edges"] = s.cut.boundary_edges;
   j["skipped_faces"] = s.cut.skipped_faces.size();
   j["charts_split_to_disks"] = s.cut.split_charts;
+  j["cut_paths"] = s.cut.path_cuts;
   j["faces_psi_unusable"] = s.cut.unusable_faces;
   j["seconds"] = s.seconds;
   j["warnings"] = s.warnings;

@@ -80,3 +80,28 @@ TEST_CASE("slim: symmetric Dirichlet is 4 on an isometry and infinite once a tri
   bad.row(5) << 2.0, 2.0;  // an inner vertex dragged outside: its fan inverts
   CHECK(std::isinf(symmetric_dirichlet(frames, m.faces, bad)));
 }
+
+TEST_CASE("slim: an iterate the caller refuses is shortened, not the end of the descent",
+          "[geometry][uv]") {
+  // A flat grid laid out at half its size (D = 2 (1/4 + 4) = 8.5): SLIM's
+  // first step goes nearly all the way to the isometry. The caller refuses any
+  // layout wider than 0.75 of the grid (standing in for a boundary that would
+  // cross itself), so the full step is refused; shorter ones are taken.
+  const test_uv::UvInput m = test_uv::flat_grid(6, 5);
+  const Block<double> start = 0.5 * m.positions.leftCols(2);
+  const double width = m.positions.col(0).maxCoeff() - m.positions.col(0).minCoeff();
+  auto narrow = [&](const Block<double>& uv) {
+    return uv.col(0).maxCoeff() - uv.col(0).minCoeff() <= 0.75 * width;
+  };
+  Block<double> uv = start;
+  const SlimReport r = slim_symmetric_dirichlet(m.positions, m.faces, uv, {}, narrow);
+  CHECK(r.energy_start == Approx(8.5).epsilon(1e-9));
+  CHECK(r.iterations >= 1);
+  CHECK(r.energy_end < r.energy_start);
+  CHECK(narrow(uv));
+  CHECK(count_inverted(m.faces, uv) == 0);
+  // Unrefused, the same start reaches the isometry (D = 4).
+  Block<double> free = start;
+  const SlimReport f = slim_symmetric_dirichlet(m.positions, m.faces, free);
+  CHECK(f.energy_end == Approx(4).epsilon(1e-3));
+}

@@ -278,7 +278,7 @@ TEST_CASE("valid uv: meshes as they come", "[geometry][uv][bad-input]") {
     CHECK(v.uv_faces(0, 0) != v.uv_faces(1, 0));
     CHECK(v.stats.charts == 2);
   }
-  SECTION("several components and a hole") {
+  SECTION("several components, each with a hole") {
     UvInput a = test_uv::flat_grid(6, 6), m = a;
     // Punch a hole: drop the 4 faces around the centre vertex (an annulus, not a disk).
     std::vector<int> keep;
@@ -298,8 +298,11 @@ TEST_CASE("valid uv: meshes as they come", "[geometry][uv][bad-input]") {
     }
     const ValidUv v = make_valid_uv(m.positions, m.faces, m.uv);
     check_valid(m, v);
-    CHECK(v.stats.charts >= 4);  // each annulus split into disks
-    CHECK(v.stats.cut.split_charts >= 2);
+    // Each annulus stays one chart, made a disk by one cut from the hole to the
+    // outer boundary (a shortest path), not split in pieces.
+    CHECK(v.stats.charts == 2);
+    CHECK(v.stats.cut.path_cuts == 2);
+    CHECK(v.stats.cut.split_charts == 0);
     CHECK(v.stats.cut.boundary_edges > 0);
   }
   SECTION("degenerate faces (a repeated vertex, collinear corners) are skipped with a warning") {

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <numeric>
+#include <queue>
 
 #include "engine/check.h"
 #include "io/geometry/triangle_frame.h"
@@ -133,6 +135,109 @@ ChartTopology chart_topology(const ChartMesh& chart) {
   t.boundary_loops = int(boundary_loops(L, Index(chart.vertex.size())).size());
   return t;
 }
+
+namespace {
+
+// A genus-0 chart that is not a disk (psi's slits and the holes left by other
+// charts inside it, or no boundary at all) made one by cutting along shortest
+// edge paths instead of splitting it: from the longest boundary loop, the
+// shortest path (3D length, Dijkstra over the chart's inner edges) to the
+// nearest loop not yet joined, then from everything joined so far to the next
+// one, until all are joined (a tree of cuts: one boundary loop). A closed chart
+// is cut along the path between two far-apart vertices. The cut edges are
+// unglued in `neighbour`. Returns the number of paths cut (0: not genus 0).
+int cut_along_paths(const ChartMesh& m, const Block<double>& positions,
+                    std::vector<int>& neighbour) {
+  const ChartTopology t = chart_topology(m);
+  if (t.is_disk() || 2 - t.euler - t.boundary_loops != 0) return 0;
+  const int V = int(m.vertex.size());
+  struct Arc {
+    int to, half;
+    double length;
+  };
+  std::vector<std::vector<Arc>> arcs(static_cast<size_t>(V));
+  for (Index i = 0; i < m.local.rows(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      const int h = 3 * m.faces[size_t(i)] + k;
+      if (neighbour[size_t(h)] < 0) continue;  // a boundary edge: nothing to cut
+      const int a = m.local(i, k), b = m.local(i, (k + 1) % 3);
+      const double len =
+          (pos(positions, m.vertex[size_t(a)]) - pos(positions, m.vertex[size_t(b)])).norm();
+      arcs[size_t(a)].push_back({b, h, len});
+    }
+  // Dijkstra from every vertex with joined[v]; stops at the first vertex with
+  // goal(v). Returns it (-1 if none) with parent half-edges to trace the path.
+  std::vector<double> dist(static_cast<size_t>(V));
+  std::vector<int> parent(static_cast<size_t>(V)), from(static_cast<size_t>(V));
+  auto dijkstra = [&](const std::vector<char>& joined, auto goal) {
+    std::fill(dist.begin(), dist.end(), std::numeric_limits<double>::infinity());
+    std::fill(parent.begin(), parent.end(), -1);
+    using Item = std::pair<double, int>;
+    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> heap;
+    for (int v = 0; v < V; ++v)
+      if (joined[size_t(v)]) dist[size_t(v)] = 0, heap.push({0.0, v});
+    int last = -1;
+    while (!heap.empty()) {
+      const auto [d, v] = heap.top();
+      heap.pop();
+      if (d > dist[size_t(v)]) continue;
+      last = v;
+      if (!joined[size_t(v)] && goal(v)) return v;
+      for (const Arc& a : arcs[size_t(v)])
+        if (d + a.length < dist[size_t(a.to)]) {
+          dist[size_t(a.to)] = d + a.length;
+          parent[size_t(a.to)] = a.half;
+          from[size_t(a.to)] = v;
+          heap.push({dist[size_t(a.to)], a.to});
+        }
+    }
+    return goal(-1) ? last : -1;  // goal(-1): "the farthest vertex will do"
+  };
+  auto cut_path = [&](int v, std::vector<char>& joined) {
+    while (parent[size_t(v)] >= 0) {
+      const int h = parent[size_t(v)], twin = neighbour[size_t(h)];
+      neighbour[size_t(h)] = -1;
+      if (twin >= 0) neighbour[size_t(twin)] = -1;
+      joined[size_t(v)] = 1;
+      v = from[size_t(v)];
+    }
+  };
+  std::vector<char> joined(size_t(V), 0);
+  if (t.boundary_loops == 0) {
+    joined[0] = 1;
+    const int a = dijkstra(joined, [](int v) { return v < 0; });
+    std::fill(joined.begin(), joined.end(), 0);
+    joined[size_t(a)] = 1;
+    const int b = dijkstra(joined, [](int v) { return v < 0; });
+    if (b < 0 || b == a) return 0;
+    cut_path(b, joined);
+    return 1;
+  }
+  std::vector<std::vector<int>> loops = boundary_loops(m.local, V);
+  std::stable_sort(loops.begin(), loops.end(),
+                   [](const auto& x, const auto& y) { return x.size() > y.size(); });
+  std::vector<int> loop_of(size_t(V), -1);
+  for (size_t l = 0; l < loops.size(); ++l)
+    for (int v : loops[l]) loop_of[size_t(v)] = int(l);
+  for (int v : loops[0]) joined[size_t(v)] = 1;
+  std::vector<char> loop_joined(loops.size(), 0);
+  loop_joined[0] = 1;
+  int paths = 0;
+  for (size_t n = 1; n < loops.size(); ++n) {
+    const int v = dijkstra(joined, [&](int w) {
+      return w >= 0 && loop_of[size_t(w)] >= 0 && !loop_joined[size_t(loop_of[size_t(w)])];
+    });
+    if (v < 0) break;  // a loop out of reach (cannot happen in a connected chart)
+    const int l = loop_of[size_t(v)];
+    cut_path(v, joined);
+    for (int w : loops[size_t(l)]) joined[size_t(w)] = 1;
+    loop_joined[size_t(l)] = 1;
+    ++paths;
+  }
+  return paths;
+}
+
+}  // namespace
 
 CutResult cut_charts(const Block<double>& positions, const Faces& faces, const Block<double>& uv,
                      const CutOptions& o) {
@@ -344,6 +449,7 @@ CutResult cut_charts(const Block<double>& positions, const Faces& faces, const B
   struct Pending {
     std::vector<int> faces;
     int id, sign, depth;
+    bool paths_tried = false;
   };
   std::vector<Pending> stack;
   for (int c = initial - 1; c >= 0; --c)
@@ -362,6 +468,16 @@ CutResult cut_charts(const Block<double>& positions, const Faces& faces, const B
       }
       out.charts.push_back(std::move(m));
       continue;
+    }
+    // Genus 0: one chart, cut along shortest paths between its boundary loops.
+    if (!p.paths_tried) {
+      const int paths = cut_along_paths(m, positions, neighbour);
+      if (paths > 0) {
+        out.path_cuts += paths;
+        p.paths_tried = true;
+        stack.push_back(std::move(p));
+        continue;
+      }
     }
     ++out.split_charts;
     if (p.depth >= o.max_split_depth || p.faces.size() < 2) {

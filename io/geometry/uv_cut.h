@@ -7,7 +7,9 @@
 // breadth-first growth over the dual graph (so small folds and slivers are
 // repaired inside a chart instead of becoming charts). Every chart is then
 // checked to be a topological disk (Euler characteristic 1, one boundary loop)
-// and split in two until it is. Degenerate faces are skipped.
+// and made one: a genus-0 chart by cutting along shortest paths between its
+// boundary loops (one chart, longer seams), any other by splitting it in two
+// until it is. Degenerate faces are skipped.
 #pragma once
 #include <string>
 #include <vector>
@@ -50,6 +52,7 @@ struct CutResult {
   Index nonmanifold_edges = 0;     // edges used by more than two faces
   Index inconsistent_edges = 0;    // edges whose two faces disagree on orientation
   Index boundary_edges = 0;        // edges of one face (holes, open borders)
+  Index path_cuts = 0;             // shortest paths cut to make a genus-0 chart a disk
   Index split_charts = 0;          // charts split because they were not disks
   Index unusable_faces = 0;        // faces whose psi UVs need repair
   std::vector<std::string> warnings;

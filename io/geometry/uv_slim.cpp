@@ -199,17 +199,22 @@ SlimReport slim_symmetric_dirichlet(const Block<double>& positions, const Faces&
     if (!x.allFinite()) break;
     Block<double> d(V, 2);
     for (Index v = 0; v < V; ++v) d.row(v) << x(v) - uv(v, 0), x(V + v) - uv(v, 1);
-    // Line search: a flip-free cap, then halving until D decreases.
+    // Line search: a flip-free cap, then halving until D decreases and the
+    // caller accepts the iterate. From Tutte's embedding the full step would
+    // often swing the boundary across itself; a shorter one still gains.
     double step = std::min(1.0, o.step_fraction * max_injective_step(local, uv, d));
     Block<double> trial;
     double e_trial = kInf;
+    bool found = false;
     for (int k = 0; k < 40 && step > 1e-12; ++k, step *= 0.5) {
       trial = uv + step * d;
       e_trial = symmetric_dirichlet(frames, local, trial);
-      if (e_trial < energy) break;
+      if (e_trial < energy && (!accept || accept(trial))) {
+        found = true;
+        break;
+      }
     }
-    if (!(e_trial < energy)) break;
-    if (accept && !accept(trial)) break;
+    if (!found) break;
     const double gain = (energy - e_trial) / energy;
     uv.swap(trial);
     energy = e_trial;

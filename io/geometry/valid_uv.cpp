@@ -88,6 +88,20 @@ std::vector<ChartOut> process_chart(const Block<double>& positions, const Faces&
     for (int f : m.faces) out.push_back(single_face(positions, faces, psi_uv, f));
     return out;
   }
+  // psi's UVs overlap themselves across this chart (its usable parts land on
+  // one another): halves are likelier to keep psi's layout than Tutte's
+  // circle is to recover it, so a large chart is split before Tutte is tried.
+  if (start.start == ChartStart::tutte && depth < o.max_split_depth &&
+      Index(m.faces.size()) >= o.split_before_tutte_faces &&
+      std::count(m.usable.begin(), m.usable.end(), 1) > Index(m.faces.size()) / 2) {
+    std::vector<ChartMesh> halves = split_chart(m);
+    if (halves.size() == 2) {
+      std::vector<ChartOut> out = process_chart(positions, faces, psi_uv, halves[0], o, depth + 1);
+      for (ChartOut& h : process_chart(positions, faces, psi_uv, halves[1], o, depth + 1))
+        out.push_back(std::move(h));
+      return out;
+    }
+  }
   ChartOut c;
   c.faces = m.faces;
   c.local = m.local;

@@ -31,6 +31,9 @@ struct ValidUvOptions {
   // max_split_depth times: more charts, less distortion.
   double split_energy = 8;
   int max_split_depth = 8;
+  // A chart of at least this many faces, mostly usable, whose psi UVs cannot
+  // be repaired into an injective start is split before Tutte is tried.
+  Index split_before_tutte_faces = 2000;
 };
 
 // stage ("cut", "charts", "pack") and the fraction of it done, from the calling thread only.
