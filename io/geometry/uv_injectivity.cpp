@@ -45,8 +45,12 @@ Index count_inverted(const Faces& local, const Block<double>& uv, double min_are
 }
 
 bool boundary_self_intersects(const Faces& local, const Block<double>& uv) {
+  return boundary_self_intersects(boundary_loops(local, uv.rows()), uv);
+}
+
+bool boundary_self_intersects(const std::vector<std::vector<int>>& loops, const Block<double>& uv) {
   std::vector<std::pair<int, int>> seg;
-  for (const auto& loop : boundary_loops(local, uv.rows()))
+  for (const auto& loop : loops)
     for (size_t i = 0; i < loop.size(); ++i) seg.push_back({loop[i], loop[(i + 1) % loop.size()]});
   if (seg.size() < 4) return false;
   Eigen::Vector2d lo = at(uv, seg[0].first), hi = lo;

@@ -79,7 +79,7 @@ bool lscm_fill(const Block<double>& positions, const Faces& local, const std::ve
 
 ChartStartResult start_chart_uv(const Block<double>& positions, const Faces& local,
                                 const Block<double>& psi, const std::vector<char>& usable,
-                                int max_rings) {
+                                int max_rings, bool tutte) {
   ChartStartResult r;
   const Index V = positions.rows();
   bool all_usable = true;
@@ -122,6 +122,7 @@ ChartStartResult start_chart_uv(const Block<double>& positions, const Faces& loc
       return r;
     }
   }
+  if (!tutte) return r;  // failed, without Tutte's embedding
   Block<double> uv = tutte_embedding(positions, local);
   if (uv.allFinite() && chart_is_injective(local, uv)) {
     r.uv = std::move(uv);

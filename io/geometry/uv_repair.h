@@ -22,10 +22,11 @@ struct ChartStartResult {
 // positions: Vc x 3 (the chart's vertices), local: Fc x 3, psi: Vc x 2 (already
 // mirrored for a mirrored chart, so usable faces are counter-clockwise),
 // usable: Fc flags. failed only if even Tutte's map is not injective (a
-// numerically degenerate chart); the caller then splits the chart.
+// numerically degenerate chart), or when psi and its repair fail and `tutte`
+// is false (the caller would rather split the chart); the caller then splits it.
 ChartStartResult start_chart_uv(const Block<double>& positions, const Faces& local,
                                 const Block<double>& psi, const std::vector<char>& usable,
-                                int max_rings = 3);
+                                int max_rings = 3, bool tutte = true);
 
 // Minimises the LSCM energy over the vertices with free[v] set, the others held
 // at uv; returns false if the system is singular (no fixed vertex in reach).

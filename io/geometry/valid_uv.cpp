@@ -82,18 +82,16 @@ std::vector<ChartOut> process_chart(const Block<double>& positions, const Faces&
                                       psi.row(m.local(f, 2)).transpose()));
   }
   const double scale = a2 > 0 && a3 > 0 ? std::sqrt(a3 / a2) : 1.0;
-  ChartStartResult start = start_chart_uv(pos, m.local, scale * psi, m.usable);
-  if (start.start == ChartStart::failed) {
-    std::vector<ChartOut> out;
-    for (int f : m.faces) out.push_back(single_face(positions, faces, psi_uv, f));
-    return out;
-  }
-  // psi's UVs overlap themselves across this chart (its usable parts land on
-  // one another): halves are likelier to keep psi's layout than Tutte's
-  // circle is to recover it, so a large chart is split before Tutte is tried.
-  if (start.start == ChartStart::tutte && depth < o.max_split_depth &&
-      Index(m.faces.size()) >= o.split_before_tutte_faces &&
-      std::count(m.usable.begin(), m.usable.end(), 1) > Index(m.faces.size()) / 2) {
+  // A large chart, mostly usable, whose psi UVs overlap themselves across it
+  // (its usable parts land on one another) and cannot be repaired: halves are
+  // likelier to keep psi's layout than Tutte's circle is to recover it, so it
+  // is split before Tutte is computed.
+  const bool split_first =
+      depth < o.max_split_depth && Index(m.faces.size()) >= o.split_before_tutte_faces &&
+      std::count(m.usable.begin(), m.usable.end(), 1) > Index(m.faces.size()) / 2;
+  ChartStartResult start =
+      start_chart_uv(pos, m.local, scale * psi, m.usable, 3, /*tutte=*/!split_first);
+  if (start.start == ChartStart::failed && split_first) {
     std::vector<ChartMesh> halves = split_chart(m);
     if (halves.size() == 2) {
       std::vector<ChartOut> out = process_chart(positions, faces, psi_uv, halves[0], o, depth + 1);
@@ -101,6 +99,12 @@ std::vector<ChartOut> process_chart(const Block<double>& positions, const Faces&
         out.push_back(std::move(h));
       return out;
     }
+    start = start_chart_uv(pos, m.local, scale * psi, m.usable);
+  }
+  if (start.start == ChartStart::failed) {
+    std::vector<ChartOut> out;
+    for (int f : m.faces) out.push_back(single_face(positions, faces, psi_uv, f));
+    return out;
   }
   ChartOut c;
   c.faces = m.faces;
@@ -110,9 +114,11 @@ std::vector<ChartOut> process_chart(const Block<double>& positions, const Faces&
   Block<double> uv = start.uv;
   // Each iterate keeps every triangle positive; the boundary is checked too, so
   // the last iterate whose boundary is simple (hence injective) is kept.
-  const SlimReport rep = slim_symmetric_dirichlet(
-      pos, m.local, uv, slim_options,
-      [&](const Block<double>& x) { return !boundary_self_intersects(m.local, x); });
+  const SlimReport rep =
+      slim_symmetric_dirichlet(pos, m.local, uv, slim_options,
+                               [&, loops = boundary_loops(m.local, Vc)](const Block<double>& x) {
+                                 return !boundary_self_intersects(loops, x);
+                               });
   c.iterations = rep.iterations;
   for (Index f = 0; f < m.local.rows(); ++f) {
     const Eigen::RowVector3d p0 = pos.row(m.local(f, 0)), p1 = pos.row(m.local(f, 1)),
