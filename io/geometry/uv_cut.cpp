@@ -541,7 +541,7 @@ CutResult cut_charts(const Block<double>& positions, const Faces& faces, const B
 
 namespace jsa {
 
-std::vector<ChartMesh> split_chart(const ChartMesh& m) {
+std::vector<ChartMesh> split_chart(const ChartMesh& m, const Block<double>* positions) {
   const int n = int(m.faces.size());
   if (n < 2) return {};
   // Local adjacency: half-edges glued when the chart has the twin b -> a.
@@ -557,18 +557,60 @@ std::vector<ChartMesh> split_chart(const ChartMesh& m) {
     if (it != half.end() && it->first == std::make_pair(edge.second, edge.first))
       neighbour[size_t(h)] = it->second;
   }
-  std::vector<int> chart_of(size_t(n), 0), dist(size_t(n), -1);
-  auto sweep = [&](int seed) {
-    std::fill(dist.begin(), dist.end(), -1);
-    return bfs_order(seed, neighbour, chart_of, 0, dist);
-  };
-  const int s1 = sweep(0).back();
-  const std::vector<int> d1 = (sweep(s1), dist);
-  const int s2 = sweep(s1).back();
-  const std::vector<int> d2 = (sweep(s2), dist);
   std::vector<int> side(static_cast<size_t>(n));
-  for (int f = 0; f < n; ++f)
-    side[size_t(f)] = d1[size_t(f)] >= 0 && d1[size_t(f)] <= d2[size_t(f)] ? 0 : 1;
+  if (positions) {
+    // Distances between face centroids along the dual graph (Dijkstra): the
+    // border between the halves follows the surface, not the mesh's rows, so
+    // the seam is shorter and straighter than a breadth-first one.
+    std::vector<Eigen::Vector3d> centre(static_cast<size_t>(n));
+    for (int f = 0; f < n; ++f) {
+      centre[size_t(f)].setZero();
+      for (int k = 0; k < 3; ++k)
+        centre[size_t(f)] += pos(*positions, m.vertex[size_t(m.local(f, k))]);
+      centre[size_t(f)] /= 3;
+    }
+    std::vector<double> dist(static_cast<size_t>(n));
+    auto sweep = [&](int seed) {
+      std::fill(dist.begin(), dist.end(), std::numeric_limits<double>::infinity());
+      using Item = std::pair<double, int>;
+      std::priority_queue<Item, std::vector<Item>, std::greater<Item>> heap;
+      dist[size_t(seed)] = 0;
+      heap.push({0.0, seed});
+      int last = seed;
+      while (!heap.empty()) {
+        const auto [d, f] = heap.top();
+        heap.pop();
+        if (d > dist[size_t(f)]) continue;
+        last = f;
+        for (int k = 0; k < 3; ++k) {
+          const int nb = neighbour[size_t(3 * f + k)];
+          if (nb < 0) continue;
+          const int g = nb / 3;
+          const double w = d + (centre[size_t(f)] - centre[size_t(g)]).norm();
+          if (w < dist[size_t(g)]) dist[size_t(g)] = w, heap.push({w, g});
+        }
+      }
+      return last;
+    };
+    const int s1 = sweep(0);
+    const int s2 = sweep(s1);
+    const std::vector<double> d1 = dist;
+    sweep(s2);
+    for (int f = 0; f < n; ++f)
+      side[size_t(f)] = std::isfinite(d1[size_t(f)]) && d1[size_t(f)] <= dist[size_t(f)] ? 1 : 0;
+  } else {
+    std::vector<int> chart_of(size_t(n), 0), dist(size_t(n), -1);
+    auto sweep = [&](int seed) {
+      std::fill(dist.begin(), dist.end(), -1);
+      return bfs_order(seed, neighbour, chart_of, 0, dist);
+    };
+    const int s1 = sweep(0).back();
+    const std::vector<int> d1 = (sweep(s1), dist);
+    const int s2 = sweep(s1).back();
+    const std::vector<int> d2 = (sweep(s2), dist);
+    for (int f = 0; f < n; ++f)
+      side[size_t(f)] = d1[size_t(f)] >= 0 && d1[size_t(f)] <= d2[size_t(f)] ? 0 : 1;
+  }
   // Sub-charts in the local numbering, then mapped back to input ids.
   Faces as_faces = m.local;
   std::vector<ChartMesh> out;

@@ -89,6 +89,9 @@ namespace jsa {
 // far-apart seeds (a double breadth-first sweep). Returns the two halves (with
 // their own local vertices, usable flags and orientation), or nothing if the
 // chart has one face or a half is not a disk.
-std::vector<ChartMesh> split_chart(const ChartMesh& chart);
+// With the input's positions (V x 3, indexed by chart.vertex) the distances
+// are 3D lengths between face centroids (Dijkstra) instead of dual-graph steps.
+std::vector<ChartMesh> split_chart(const ChartMesh& chart,
+                                   const Block<double>* positions = nullptr);
 
 }  // namespace jsa

@@ -92,7 +92,7 @@ std::vector<ChartOut> process_chart(const Block<double>& positions, const Faces&
   ChartStartResult start =
       start_chart_uv(pos, m.local, scale * psi, m.usable, 3, /*tutte=*/!split_first);
   if (start.start == ChartStart::failed && split_first) {
-    std::vector<ChartMesh> halves = split_chart(m);
+    std::vector<ChartMesh> halves = split_chart(m, &positions);
     if (halves.size() == 2) {
       std::vector<ChartOut> out = process_chart(positions, faces, psi_uv, halves[0], o, depth + 1);
       for (ChartOut& h : process_chart(positions, faces, psi_uv, halves[1], o, depth + 1))
@@ -152,7 +152,7 @@ std::vector<ChartOut> process_chart(const Block<double>& positions, const Faces&
   // Still far from an isometry (SLIM was stopped by the boundary, or the chart
   // cannot flatten): cut it in two and do each half again.
   if (c.energy_end > o.split_energy && depth < o.max_split_depth) {
-    std::vector<ChartMesh> halves = split_chart(m);
+    std::vector<ChartMesh> halves = split_chart(m, &positions);
     if (halves.size() == 2) {
       std::vector<ChartOut> out = process_chart(positions, faces, psi_uv, halves[0], o, depth + 1);
       for (ChartOut& h : process_chart(positions, faces, psi_uv, halves[1], o, depth + 1))
