@@ -627,6 +627,15 @@ std::vector<ChartMesh> split_chart(const ChartMesh& m, const Block<double>* posi
       }
     // build_chart_mesh reads edge l of the neighbour as running b -> a, as here.
     ChartMesh sub = build_chart_mesh(as_faces, members, glued, side, s);
+    if (!chart_topology(sub).is_disk() && positions) {
+      // A half of a chart that was made a disk by cuts (slits joined by paths)
+      // can cut a path in two and keep a hole: join its loops by paths too.
+      Block<double> local_positions(Index(m.vertex.size()), 3);
+      for (size_t v = 0; v < m.vertex.size(); ++v)
+        local_positions.row(Index(v)) = positions->row(m.vertex[v]);
+      if (cut_along_paths(sub, local_positions, glued) > 0)
+        sub = build_chart_mesh(as_faces, members, glued, side, s);
+    }
     if (!chart_topology(sub).is_disk()) return {};
     for (size_t i = 0; i < sub.faces.size(); ++i) {
       const int f = sub.faces[i];

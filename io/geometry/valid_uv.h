@@ -29,8 +29,8 @@ struct ValidUvOptions {
   // A chart whose symmetric Dirichlet energy (4 for an isometry) stays above
   // this after optimisation is cut in two and each half redone, at most
   // max_split_depth times: more charts, less distortion.
-  double split_energy = 8;
-  int max_split_depth = 8;
+  double split_energy = 6;
+  int max_split_depth = 12;
   // A chart of at least this many faces, mostly usable, whose psi UVs cannot
   // be repaired into an injective start is split before Tutte is tried.
   Index split_before_tutte_faces = 2000;
