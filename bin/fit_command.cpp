@@ -453,6 +453,9 @@ void run_fit(FitArgs& a, Team& team) {
   const int64_t warmup = 5, probe = 20;
   auto probe_start = start;
   bool sized = !(a.minutes > 0) || resuming;
+  const bool budgeted = !sized;
+  int64_t recheck_from = 0, recheck = 0;
+  auto recheck_time = start;
   if (!sized && o.iterations < first + warmup + probe) {
     // Too short to be timed (the loop below would wait for iteration 25
     // forever): the timed steps run as those of a default-length run.
@@ -477,9 +480,45 @@ void run_fit(FitArgs& a, Team& team) {
       trainer.set_iterations(n);
       o.iterations = n;
       sized = true;
+      recheck_from = trainer.iteration();
+      recheck_time = now;
+      recheck = std::max<int64_t>(10, n / 25);
       if (!a.quiet)
         std::cerr << "fit: " << a.minutes << " min at " << per * 1e3 << " ms/iteration -> " << n
                   << " iterations\n";
+    }
+    // Keeping the budget: the first estimate comes from 20 cheap steps and a
+    // cost model, and a machine whose load changes (or a model that is off)
+    // would overrun it. Every `recheck` steps, the time per unit of modelled
+    // cost over the last stretch re-estimates what is left; until the first
+    // learning-rate decay the run is shortened to fit (never lengthened), and
+    // past the budget it stops where it is. Ranks decide on rank 0's numbers.
+    if (budgeted && sized && trainer.iteration() - recheck_from >= recheck && !trainer.finished()) {
+      const auto now = clock::now();
+      const int64_t i = trainer.iteration(), n = o.iterations;
+      const double stretch = std::chrono::duration<double>(now - recheck_time).count();
+      const double done_cost =
+          scheduled_mean_cost(o.schedule, o.points, kStepOverheadPoints, recheck_from, i, n) *
+          double(i - recheck_from);
+      const double per_cost = stretch / std::max(done_cost, 1e-9);
+      const double left =
+          a.minutes * 60.0 - wrap_seconds - std::chrono::duration<double>(now - start).count();
+      const int64_t first_decay = o.decay_at.empty() ? n : int64_t(o.decay_at.front() * double(n));
+      int64_t fit_n = budgeted_iterations(o.schedule, o.points, kStepOverheadPoints, i, n,
+                                          first_decay, per_cost, left);
+      fit_n = int64_t(rank0_value(double(fit_n)));
+      if (fit_n < n) {
+        trainer.set_iterations(fit_n);
+        o.iterations = fit_n;
+        if (!a.quiet)
+          std::cerr << "fit: " << per_cost * (kStepOverheadPoints + double(o.points)) * 1e3
+                    << " ms per full step now; the run is shortened to " << fit_n
+                    << " iterations to keep --minutes " << a.minutes << "\n";
+      }
+      recheck_from = i;
+      recheck_time = now;
+      recheck = std::max<int64_t>(10, o.iterations / 25);
+      if (trainer.finished()) continue;
     }
     if (trainer.finished()) continue;
     try {

@@ -210,3 +210,34 @@ TEST_CASE("schedule: out-of-range settings are refused naming the setting", "[sc
   o.schedule.levels = 0;
   CHECK_THROWS_WITH(jsa::Trainer(o, pool), "schedule.levels must be in [1, 1000]");
 }
+
+TEST_CASE("budgeted_iterations: a run is shortened to what is left, never lengthened",
+          "[tool][schedule]") {
+  jsa::ScheduleOptions ramp;  // the default: M from 625 to 2500 over 3/4 of the run
+  const jsa::Index m = 2500;
+  const double overhead = jsa::kStepOverheadPoints;
+  const int64_t n = 1000, decay = 750;
+  // The rest of the run at iteration 100, in modelled cost units.
+  const double rest = jsa::scheduled_mean_cost(ramp, m, overhead, 100, n, n) * double(n - 100);
+  // Time enough (1 s per 1000 cost units, and the rest needs rest / 1000 s): unchanged.
+  CHECK(jsa::budgeted_iterations(ramp, m, overhead, 100, n, decay, 1e-3, rest * 1e-3) == n);
+  // Steps twice as dear as planned: shortened, and the new rest fits in 97% of what is left.
+  const int64_t k = jsa::budgeted_iterations(ramp, m, overhead, 100, n, decay, 2e-3, rest * 1e-3);
+  REQUIRE(k > 100);
+  REQUIRE(k < n);
+  const double kept = jsa::scheduled_mean_cost(ramp, m, overhead, 100, k, k) * double(k - 100);
+  CHECK(kept * 2e-3 <= 0.97 * rest * 1e-3);
+  // ... and it is the longest such run: one step more would not fit.
+  const double more =
+      jsa::scheduled_mean_cost(ramp, m, overhead, 100, k + 1, k + 1) * double(k + 1 - 100);
+  CHECK(more * 2e-3 > 0.97 * rest * 1e-3);
+  // Cheaper steps than planned: never lengthened.
+  CHECK(jsa::budgeted_iterations(ramp, m, overhead, 100, n, decay, 1e-4, rest * 1e-3) == n);
+  // Past the first decay the length stays (moving the decays would break the schedule) ...
+  CHECK(jsa::budgeted_iterations(ramp, m, overhead, 800, n, decay, 2e-3, 1.0) == n);
+  // ... and once the budget is spent the run ends where it is.
+  CHECK(jsa::budgeted_iterations(ramp, m, overhead, 800, n, decay, 2e-3, 0.0) == 800);
+  CHECK(jsa::budgeted_iterations(ramp, m, overhead, 100, n, decay, 2e-3, -5.0) == 100);
+  // No time for even one step: one more step, not a run that never ends.
+  CHECK(jsa::budgeted_iterations(ramp, m, overhead, 100, n, decay, 1.0, 1e-9) == 101);
+}

@@ -85,4 +85,31 @@ inline double scheduled_cost_ratio(const ScheduleOptions& s, Index points, doubl
          (overhead + double(scheduled_points(s, points, 0, 10000)));
 }
 
+// Keeping a time budget mid-run (`jsatlas fit --minutes`): at iteration i of
+// a run of n, with `seconds_per_cost` measured over the last steps (seconds
+// per unit of modelled cost, overhead + M) and `seconds_left` of the budget,
+// the length the run should have: i when the budget is spent; n when the rest
+// fits (within 2%) or the first decay (`first_decay`, an iteration) is passed,
+// since moving the decays then would break the schedule; else the longest
+// length whose rest fits in 97% of what is left (at least i + 1). Never more
+// than n: a run is shortened, not lengthened.
+inline int64_t budgeted_iterations(const ScheduleOptions& s, Index points, double overhead,
+                                   int64_t i, int64_t n, int64_t first_decay,
+                                   double seconds_per_cost, double seconds_left) {
+  if (seconds_left <= 0) return i;
+  auto cost_left = [&](int64_t m) {
+    return scheduled_mean_cost(s, points, overhead, i, m, m) * double(m - i);
+  };
+  if (i >= first_decay || cost_left(n) * seconds_per_cost <= 1.02 * seconds_left) return n;
+  int64_t lo = i + 1, hi = n;
+  while (lo < hi) {
+    const int64_t mid = lo + (hi - lo + 1) / 2;
+    if (cost_left(mid) * seconds_per_cost <= 0.97 * seconds_left)
+      lo = mid;
+    else
+      hi = mid - 1;
+  }
+  return lo;
+}
+
 }  // namespace jsa
