@@ -57,9 +57,11 @@ template class Atlas<float>;
 template class Atlas<double>;
 
 void evaluate_surface(Atlas<float>& atlas, const Block<double>& uv, Block<double>& points,
-                      Block<double>& normals, int shape) {
+                      Block<double>& normals, int shape, Block<double>* du, Block<double>* dv) {
   points.resize(uv.rows(), 3);
   normals.resize(uv.rows(), 3);
+  if (du) du->resize(uv.rows(), 3);
+  if (dv) dv->resize(uv.rows(), 3);
   Tape<float> t;
   const Index batch = 8192;
   for (Index b = 0; b < uv.rows(); b += batch) {
@@ -69,6 +71,8 @@ void evaluate_surface(Atlas<float>& atlas, const Block<double>& uv, Block<double
     SurfacePoints s = atlas.phi.evaluate(t, atlas.params, x, true, atlas.phi_code(t, shape));
     points.middleRows(b, n) = t.value(s.points).cast<double>();
     normals.middleRows(b, n) = t.value(s.normals).cast<double>().rowwise().normalized();
+    if (du) du->middleRows(b, n) = t.value(s.du).cast<double>();
+    if (dv) dv->middleRows(b, n) = t.value(s.dv).cast<double>();
   }
 }
 

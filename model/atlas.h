@@ -51,9 +51,11 @@ class Atlas {
 };
 
 // The reconstruction (Sec. 3): phi of shape `shape` at the rows of uv (V x 2),
-// in batches: points (V x 3, unit frame) and unit normals (V x 3).
+// in batches: points (V x 3, unit frame) and unit normals (V x 3); with du, dv
+// also the Jacobian's columns dphi/du, dphi/dv (V x 3 each, Eq. 2's J).
 void evaluate_surface(Atlas<float>& atlas, const Block<double>& uv, Block<double>& points,
-                      Block<double>& normals, int shape = 0);
+                      Block<double>& normals, int shape = 0, Block<double>* du = nullptr,
+                      Block<double>* dv = nullptr);
 
 // `count` points of the reconstruction: uv ~ P, points = phi(uv), unit normals.
 void sample_reconstruction(Atlas<float>& atlas, Index count, Rng& rng, Block<double>& uv,

@@ -17,26 +17,6 @@ Block<double> vertex_normals_of(const Mesh& mesh) {
 
 namespace {
 
-// phi_I at uv with its Jacobian columns (unit frame).
-void surface_with_jacobian(Atlas<float>& atlas, const Block<double>& uv, int shape,
-                           Block<double>& q, Block<double>& du, Block<double>& dv) {
-  q.resize(uv.rows(), 3);
-  du.resize(uv.rows(), 3);
-  dv.resize(uv.rows(), 3);
-  Tape<float> t;
-  const Index batch = 8192;
-  for (Index b = 0; b < uv.rows(); b += batch) {
-    const Index n = std::min(batch, uv.rows() - b);
-    t.clear();
-    SurfacePoints s =
-        atlas.phi.evaluate(t, atlas.params, t.constant(uv.middleRows(b, n).cast<float>()), true,
-                           atlas.phi_code(t, shape));
-    q.middleRows(b, n) = t.value(s.points).cast<double>();
-    du.middleRows(b, n) = t.value(s.du).cast<double>();
-    dv.middleRows(b, n) = t.value(s.dv).cast<double>();
-  }
-}
-
 // Minimises |phi_I(u) - p|^2 over u from the start uv: Levenberg-Marquardt per
 // point, (J^T J + lambda diag(J^T J)) du = J^T (p - phi(u)); a step that does not
 // lower the residual is undone and lambda grows tenfold, else lambda shrinks.
@@ -45,9 +25,9 @@ void refine_inverse(Atlas<float>& atlas, int shape, const Block<double>& p, int 
   const Index n = p.rows();
   std::vector<double> lambda(size_t(n), 1e-3),
       best(size_t(n), std::numeric_limits<double>::infinity());
-  Block<double> best_uv = uv, q, du, dv;
+  Block<double> best_uv = uv, q, normals, du, dv;
   for (int k = 0; k <= steps; ++k) {
-    surface_with_jacobian(atlas, uv, shape, q, du, dv);
+    evaluate_surface(atlas, uv, q, normals, shape, &du, &dv);  // phi_I(u) and its Jacobian
     for (Index i = 0; i < n; ++i) {
       const Eigen::RowVector3d r = p.row(i) - q.row(i);
       const double e = r.squaredNorm();
