@@ -91,14 +91,19 @@ std::vector<ChartOut> process_chart(const Block<double>& positions, const Faces&
       std::count(m.usable.begin(), m.usable.end(), 1) > Index(m.faces.size()) / 2;
   ChartStartResult start =
       start_chart_uv(pos, m.local, scale * psi, m.usable, 3, /*tutte=*/!split_first);
+  // The chart cut in two and each half done again; empty if it cannot be cut.
+  auto halves_redone = [&]() {
+    std::vector<ChartOut> out;
+    const std::vector<ChartMesh> halves = split_chart(m, &positions);
+    if (halves.size() != 2) return out;
+    for (const ChartMesh& h : halves)
+      for (ChartOut& c : process_chart(positions, faces, psi_uv, h, o, depth + 1))
+        out.push_back(std::move(c));
+    return out;
+  };
   if (start.start == ChartStart::failed && split_first) {
-    std::vector<ChartMesh> halves = split_chart(m, &positions);
-    if (halves.size() == 2) {
-      std::vector<ChartOut> out = process_chart(positions, faces, psi_uv, halves[0], o, depth + 1);
-      for (ChartOut& h : process_chart(positions, faces, psi_uv, halves[1], o, depth + 1))
-        out.push_back(std::move(h));
-      return out;
-    }
+    std::vector<ChartOut> out = halves_redone();
+    if (!out.empty()) return out;
     start = start_chart_uv(pos, m.local, scale * psi, m.usable);
   }
   if (start.start == ChartStart::failed) {
@@ -152,13 +157,8 @@ std::vector<ChartOut> process_chart(const Block<double>& positions, const Faces&
   // Still far from an isometry (SLIM was stopped by the boundary, or the chart
   // cannot flatten): cut it in two and do each half again.
   if (c.energy_end > o.split_energy && depth < o.max_split_depth) {
-    std::vector<ChartMesh> halves = split_chart(m, &positions);
-    if (halves.size() == 2) {
-      std::vector<ChartOut> out = process_chart(positions, faces, psi_uv, halves[0], o, depth + 1);
-      for (ChartOut& h : process_chart(positions, faces, psi_uv, halves[1], o, depth + 1))
-        out.push_back(std::move(h));
-      return out;
-    }
+    std::vector<ChartOut> out = halves_redone();
+    if (!out.empty()) return out;
   }
   return {std::move(c)};
 }
