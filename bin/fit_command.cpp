@@ -550,6 +550,10 @@ void run_fit(FitArgs& a, Team& team) {
   const uint64_t bytes = team.bytes_exchanged();
   save();
   if (!root) return;
+  // The surface samples back for the outputs' back-facing measure (the
+  // trainer held the only copy; their normals' length does not matter there).
+  for (size_t i = 0; i < shapes.size(); ++i)
+    if (trainer.pool(int(i)).rows() > 0) shapes[i].pool = trainer.pool(int(i)).cast<double>();
   write_run_outputs(trainer.atlas(), shapes, log, dir,
                     MeshOutputOptions{a.mesh_resolution, a.mesh_threshold, a.quiet, a.texture});
   if (!a.quiet) {

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_write.h"
+#include "io/geometry/nearest.h"
 #include "io/geometry/valid_uv.h"
 #include "io/mesh_io.h"
 #include "io/pictures/raster.h"
@@ -94,8 +95,36 @@ Block<double> shared_layout(const Block<double>& frame_uv, int texture_size, dou
 
 std::string json_quote(const std::string& s) { return nlohmann::json(s).dump(); }
 
+// The share of the mesh's area (unit frame) whose faces point away from the
+// surface: each face's normal against the normal of the surface sample
+// nearest its centroid. The meshed domain's faces are counter-clockwise in
+// UV, so their normals are phi's (J_u x J_v); a flap of phi folded back over
+// the surface faces away from it.
+double back_facing_area_fraction(const Block<double>& points, const Faces& faces,
+                                 const Block<double>& surface) {
+  Block<double> centre(faces.rows(), 3);
+  for (Index f = 0; f < faces.rows(); ++f)
+    centre.row(f) =
+        (points.row(faces(f, 0)) + points.row(faces(f, 1)) + points.row(faces(f, 2))) / 3;
+  const NearestIndex<double> index(surface.leftCols(3));
+  std::vector<int> nn;
+  index.query(centre, nn);
+  double back = 0, total = 0;
+  for (Index f = 0; f < faces.rows(); ++f) {
+    const Eigen::Vector3d p0 = points.row(faces(f, 0)).transpose();
+    const Eigen::Vector3d e1 = points.row(faces(f, 1)).transpose() - p0;
+    const Eigen::Vector3d e2 = points.row(faces(f, 2)).transpose() - p0;
+    const Eigen::Vector3d n = e1.cross(e2);
+    const Eigen::Vector3d ns = surface.row(nn[size_t(f)]).rightCols<3>().transpose();
+    total += 0.5 * n.norm();
+    if (n.dot(ns) < 0) back += 0.5 * n.norm();
+  }
+  return total > 0 ? back / total : 0.0;
+}
+
 void write_domain_mesh(Atlas<float>& atlas, const Normalization& normalization,
-                       const std::string& obj_path, const MeshOutputOptions& o, int shape) {
+                       const std::string& obj_path, const MeshOutputOptions& o, int shape,
+                       const Block<double>* surface) {
   const auto start = std::chrono::steady_clock::now();
   const DomainMesh dm = mesh_domain(atlas, DomainMeshOptions{o.resolution, o.threshold});
   if (dm.faces.rows() == 0)
@@ -116,20 +145,28 @@ void write_domain_mesh(Atlas<float>& atlas, const Normalization& normalization,
   const UvQuality q = measure_uv_quality(out.vertices, out.faces, vt, out.faces);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  write_report(stem + "_uv.json", q,
-               {{"domain_mass_fraction", dm.mass_fraction},
-                {"threshold", o.threshold},
-                {"level", dm.level},
-                {"map", "domain uv -> phi (3D)"},
-                {"seconds", seconds},
-                {"padding_texels", o.padding},
-                {"texture_size", o.texture_size}});
+  nlohmann::json extra = {{"domain_mass_fraction", dm.mass_fraction},
+                          {"threshold", o.threshold},
+                          {"level", dm.level},
+                          {"map", "domain uv -> phi (3D)"},
+                          {"seconds", seconds},
+                          {"padding_texels", o.padding},
+                          {"texture_size", o.texture_size}};
+  double back = -1;
+  if (surface && surface->rows() > 0) {  // `show` has no surface samples: nothing to measure
+    back = back_facing_area_fraction(points, out.faces, *surface);
+    extra["back_facing_area_fraction"] = back;
+  }
+  write_report(stem + "_uv.json", q, extra);
   write_png(stem + ".png", domain_coloured_views(out.vertices, out.faces, vt));
   if (!o.quiet) {
     std::cerr << "mesh: " << obj_path << "  (" << out.vertices.rows() << " vertices, "
               << out.faces.rows() << " triangles; the domain holds "
               << int(100 * dm.mass_fraction + 0.5) << "% of P's mass)\n";
     std::cerr << to_text(q);
+    if (back >= 0)
+      std::cerr << "  back-facing (of 3D area) " << 100 * back
+                << "%   ideal 0; phi's flaps folded over the surface\n";
   }
 }
 
@@ -217,7 +254,8 @@ void write_run_outputs(Atlas<float>& atlas, const std::vector<RunInput>& inputs,
       fs::create_directories(sub);
       if (!mesh.quiet) std::cerr << "shape " << i << ":\n";
     }
-    write_domain_mesh(atlas, inputs[i].normalization, sub + "/domain_mesh.obj", mesh, int(i));
+    write_domain_mesh(atlas, inputs[i].normalization, sub + "/domain_mesh.obj", mesh, int(i),
+                      &inputs[i].pool);
     if (inputs[i].mesh.faces.rows() > 0) {
       ChartOutputOptions co;
       co.quiet = mesh.quiet;

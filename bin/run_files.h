@@ -21,9 +21,12 @@ struct MeshOutputOptions {
   double padding = 4;       // texels kept free around charts and along the border
 };
 // OUT.obj (+ .mtl, texture PNG, _uv.json report, .png three views): the
-// thresholded domain mapped through phi, in the input's frame.
+// thresholded domain mapped through phi, in the input's frame. With the
+// shape's surface samples (P x 6 [x, n], unit frame) the report also gives the
+// share of the mesh's area that faces away from the surface (phi's flaps).
 void write_domain_mesh(Atlas<float>& atlas, const Normalization& normalization,
-                       const std::string& obj_path, const MeshOutputOptions& o, int shape = 0);
+                       const std::string& obj_path, const MeshOutputOptions& o, int shape = 0,
+                       const Block<double>* surface = nullptr);
 
 struct ChartOutputOptions {
   bool psi_only = false;    // write psi's UVs as they are (no cut, repair or packing): the "before"

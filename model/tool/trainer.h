@@ -266,6 +266,10 @@ class Trainer {
   std::pair<int, int> shape_block() const { return {first_shape_, last_shape_}; }
   Tape<float>& tape() { return tape_; }
 
+  // Shape s's pool as the trainer holds it (P x 6, normals scaled by alpha;
+  // empty for a shape of another rank's block).
+  const Block<float>& pool(int s) const { return pools_[size_t(s)]; }
+
   // The last good state is refreshed every this many iterations.
   static constexpr int64_t kSnapshotEvery = 50;
 
