@@ -126,24 +126,21 @@ double share_mismatch(const Sets& s, const Eigen::Matrix3d& r, const Block<doubl
   std::vector<char> keep;
   double sum = 0;
   Index pairs = 0;
-  // The pairs the score keeps (RigidAlignOptions::trim), so a moved limb is
-  // left out here as it is from the Chamfer.
-  s.fixed_index.query(s.moving * r, nn, &d2);
-  kept_pairs(d2, s.trim, keep);
-  for (Index i = 0; i < s.moving.rows(); ++i)
-    if (keep[size_t(i)]) {
-      sum +=
-          (moving_shares.row(i) - fixed_shares.row(nn[size_t(i)])).cwiseAbs().cwiseProduct(w).sum();
-      ++pairs;
-    }
-  s.moving_index.query(s.fixed * r.transpose(), nn, &d2);
-  kept_pairs(d2, s.trim, keep);
-  for (Index j = 0; j < s.fixed.rows(); ++j)
-    if (keep[size_t(j)]) {
-      sum +=
-          (fixed_shares.row(j) - moving_shares.row(nn[size_t(j)])).cwiseAbs().cwiseProduct(w).sum();
-      ++pairs;
-    }
+  // One direction: the points of `from` (already posed) against their nearest
+  // in `to`, over the pairs the score keeps (RigidAlignOptions::trim), so a
+  // moved limb is left out here as it is from the Chamfer.
+  auto one_way = [&](const Block<double>& from, const Block<double>& from_shares,
+                     const NearestIndex<double>& to, const Block<double>& to_shares) {
+    to.query(from, nn, &d2);
+    kept_pairs(d2, s.trim, keep);
+    for (Index i = 0; i < from.rows(); ++i)
+      if (keep[size_t(i)]) {
+        sum += (from_shares.row(i) - to_shares.row(nn[size_t(i)])).cwiseAbs().cwiseProduct(w).sum();
+        ++pairs;
+      }
+  };
+  one_way(s.moving * r, moving_shares, s.fixed_index, fixed_shares);
+  one_way(s.fixed * r.transpose(), fixed_shares, s.moving_index, moving_shares);
   return sum / double(pairs);
 }
 
