@@ -65,8 +65,10 @@ std::string format_duration(double seconds) {
   return buf;
 }
 
-// The library names settings (FitOptions' fields); the user knows the flags.
-Trainer make_trainer(const FitOptions& o, const std::vector<Block<double>>& pools, Team* team) {
+// The library names settings (FitOptions' fields); the user knows the flags:
+// runs `f` and renames the setting that starts an InputError's message.
+template <class F>
+auto with_flag_names(F&& f) {
   static const std::pair<const char*, const char*> kFlags[] = {
       {"points", "--points"},
       {"iterations", "--iters"},
@@ -94,7 +96,7 @@ Trainer make_trainer(const FitOptions& o, const std::vector<Block<double>>& pool
       {"schedule.levels", "--ramp-levels"},
       {"schedule.warmup", "--warmup"}};
   try {
-    return Trainer(o, pools, team);
+    return f();
   } catch (const InputError& e) {
     const std::string m = e.what();
     for (const auto& [setting, flag] : kFlags)
@@ -102,6 +104,10 @@ Trainer make_trainer(const FitOptions& o, const std::vector<Block<double>>& pool
         throw InputError(std::string(flag) + m.substr(std::strlen(setting)));
     throw;
   }
+}
+
+Trainer make_trainer(const FitOptions& o, const std::vector<Block<double>>& pools, Team* team) {
+  return with_flag_names([&] { return Trainer(o, pools, team); });
 }
 
 // The processes of this run: the MPI job when an MPI launcher started us, else one.
@@ -168,6 +174,13 @@ void run_fit(FitArgs& a, Team& team) {
   }
   if (a.threads >= 0) o.threads = a.threads;
   set_threads(o.threads);
+  if (many && !resuming) {
+    // Before the inputs are read and posed (minutes on large meshes). The
+    // automatic template start (-1) is turned off below, not refused.
+    FitOptions asked = o;
+    if (asked.template_steps < 0) asked.template_steps = 0;
+    with_flag_names([&] { Trainer::require_rank_support(asked, int(inputs.size()), team.size()); });
+  }
   if (!a.texture.empty())
     (void)read_image(a.texture);  // a bad texture fails now, not after training
 

@@ -55,14 +55,9 @@ static void validate(const FitOptions& o) {
   require(s.warmup >= 0 && s.warmup <= 1, "schedule.warmup must be in [0, 1]");
 }
 
-Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools, Team* team)
-    : options_(o), team_(team), rng_(o.seed, 0) {
-  JSA_CHECK(!pools.empty(), "no shapes to fit");
-  validate(o);
-  const int n = int(pools.size());
-  const int ranks = team ? team->size() : 1;
-  if (ranks > n)
-    throw InputError(std::to_string(ranks) + " MPI ranks for " + std::to_string(n) +
+void Trainer::require_rank_support(const FitOptions& o, int shapes, int ranks) {
+  if (ranks > shapes)
+    throw InputError(std::to_string(ranks) + " MPI ranks for " + std::to_string(shapes) +
                      " shapes: run at most one rank per shape");
   if (ranks > 1 && o.wrap_steps > 0)
     throw InputError("wrap_steps is not supported with more than one MPI rank");
@@ -70,8 +65,17 @@ Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools, T
     throw InputError("reseed_every is not supported with more than one MPI rank");
   // The template start trains shape 0 alone: one rank would work while the
   // others wait, so a data-parallel run starts all shapes jointly.
-  if (ranks > 1 && template_steps_for(o, o.iterations, n) > 0)
+  if (ranks > 1 && template_steps_for(o, o.iterations, shapes) > 0)
     throw InputError("template_steps is not supported with more than one MPI rank");
+}
+
+Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools, Team* team)
+    : options_(o), team_(team), rng_(o.seed, 0) {
+  JSA_CHECK(!pools.empty(), "no shapes to fit");
+  validate(o);
+  const int n = int(pools.size());
+  const int ranks = team ? team->size() : 1;
+  require_rank_support(o, n, ranks);
   std::tie(first_shape_, last_shape_) = jsa::shape_block(n, ranks, team ? team->rank() : 0);
   for (int i = 0; i < n; ++i) {
     const Block<double>& pool = pools[size_t(i)];

@@ -228,6 +228,10 @@ class Trainer {
   int64_t template_done() const { return template_done_; }
   // template_steps resolved from template_share for a run of `iterations` joint steps.
   static int64_t template_steps_for(const FitOptions& o, int64_t iterations, int shapes);
+  // Throws InputError for what a run over `ranks` MPI ranks cannot do (more
+  // ranks than shapes, wrap, reseed, a template start). The constructor calls
+  // it; `fit` calls it before reading the inputs, so a refused job fails at once.
+  static void require_rank_support(const FitOptions& o, int shapes, int ranks);
   void set_template_steps(int64_t n) { options_.template_steps = n; }
   double learning_rate() const;  // the schedule at the current iteration, times the fault scale
   // M at the current iteration (the schedule's ramp). The template start runs

@@ -9,6 +9,9 @@
 #   ramp         --schedule ramp (M 16, 32, 48, 64 over the first 9 of 12 steps) on 2
 #                ranks, and on 2 ranks stopped at 3 (where M changes) and resumed on
 #                1: within BOUND of the 1-process ramp (every rank draws the same M)
+#   align        the pose step (--align) on 1 process and on 2 ranks: same rotations,
+#                parameters within BOUND (the other modes skip it: on the symmetric
+#                builtins it tries every axis order and is most of a run's time)
 #   errors       more ranks than shapes, --wrap or --template-steps over 2 ranks: a one-line
 #                error, the job ends non-zero
 # Usage: run_tests.sh MODE JSATLAS COMPARE MPIEXEC WORKDIR BOUND
@@ -18,12 +21,12 @@ mkdir -p "$work"
 cd "$work"
 printf 'builtin:sphere\nbuiltin:torus\nbuiltin:cube\nbuiltin:capsule\n' > shapes.txt
 # Small enough for seconds per run; orientation checks every 4 steps exercise its sum over ranks.
-# The pose step (--align, the default) runs on every rank, so the comparisons
-# cover it. No template start (refused on more than one rank; its automatic
+# The pose step runs on every rank; mode align compares it over ranks, the
+# others skip it (--no-align). No template start (refused on more than one rank; its automatic
 # length is 0 there): the 1-process reference must train the same way.
 fit=(fit --list shapes.txt --iters 12 -M 64 -K 64 --width 16 --depth 2 --code-size 8 --pool 2000
      --threads 1 --orient-every 4 --mesh-resolution 8 --checkpoint-every 0 --seed 5 -q
-     --template-steps 0)
+     --template-steps 0 --no-align)
 launch=("$mpiexec" --oversubscribe --bind-to none)
 [ "$(id -u)" -eq 0 ] && launch+=(--allow-run-as-root)
 run() {  # run NP ARGS...: one process without mpirun, else NP ranks
@@ -40,8 +43,12 @@ case "$mode" in
     "$compare" one/model.ckpt "$mode/model.ckpt" "$bound"
     # Rank 0 wrote every output of the collection.
     for i in 0 1 2 3; do test -s "$mode/shape_$i/domain_mesh.obj"; done
-    test -s "$mode/losses.csv"
-    cmp one/rotations.json "$mode/rotations.json" ;;
+    test -s "$mode/losses.csv" ;;
+  align)
+    rm -rf one_align && run 1 "${fit[@]}" --align -o one_align
+    rm -rf np2_align && run 2 "${fit[@]}" --align -o np2_align
+    "$compare" one_align/model.ckpt np2_align/model.ckpt "$bound"
+    cmp one_align/rotations.json np2_align/rotations.json ;;
   determinism)
     rm -rf np2_again && run 2 "${fit[@]}" -o np2_again
     "$compare" np2/model.ckpt np2_again/model.ckpt
