@@ -395,8 +395,22 @@ void run_fit(FitArgs& a, Team& team) {
       trainer.train_template(warm, cancelled);
       const auto p0 = clock::now();
       trainer.train_template(timed, cancelled);
-      const double per = std::chrono::duration<double>(clock::now() - p0).count() / double(timed);
-      steps = std::max<int64_t>(warm + timed, int64_t(o.template_share * a.minutes * 60.0 / per));
+      double per = std::chrono::duration<double>(clock::now() - p0).count() / double(timed);
+      // Its share of the budget in seconds, trained in stretches of about a
+      // 25th, each re-timed: a step rate measured once goes stale when the
+      // machine's load changes (one timed start on a busy machine gave the
+      // template 8 of 10 minutes instead of 3).
+      const double target = o.template_share * a.minutes * 60.0;
+      const int64_t stretch = std::max<int64_t>(25, int64_t(target / per / 25.0));
+      for (;;) {
+        const double left = target - std::chrono::duration<double>(clock::now() - t0).count();
+        const int64_t n = std::min<int64_t>(stretch, int64_t(left / per));
+        if (n < 1 || g_signal) break;
+        const auto s0 = clock::now();
+        trainer.train_template(n, cancelled);
+        per = std::chrono::duration<double>(clock::now() - s0).count() / double(n);
+      }
+      steps = trainer.template_done();
     } else if (steps < 0) {
       steps = Trainer::template_steps_for(o, o.iterations, int(inputs.size()));
     }
