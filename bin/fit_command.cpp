@@ -83,6 +83,7 @@ auto with_flag_names(F&& f) {
       {"weights.isometry", "--w-iso"},
       {"weights.repulsion", "--w-rep"},
       {"weights.code", "--w-code"},
+      {"weights.metric", "--w-metric"},
       {"repulsion_tolerance", "--repulsion-tolerance"},
       {"wrap_steps", "--wrap"},
       {"reseed_every", "--reseed"},
@@ -632,6 +633,12 @@ void add_fit(CLI::App& app) {
       ->check(CLI::Range(1, 4096));
   c->add_option("--w-code", o.weights.code,
                 "Collections: weight of the mean squared norm of the codes")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber)
+      ->check(kFinite);
+  c->add_option("--w-metric", o.weights.metric,
+                "Collections: lambda_metric on L_metric, each shape's metric J^T J against shape "
+                "0's at the same domain points (beyond the paper; 0: off; docs/collections.md)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber)
       ->check(kFinite);

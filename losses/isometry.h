@@ -12,4 +12,16 @@ namespace jsa {
 template <class T>
 Var isometry_loss(Tape<T>& t, Var du, Var dv);
 
+// L_metric (collections; beyond the paper, docs/collections.md): two shapes'
+// first fundamental forms at the same domain points, (J_u^a, J_v^a) and
+// (J_u^b, J_v^b) row by row, should agree:
+//   L_metric = (1/M) sum_m |J_a^T J_a - J_b^T J_b|_F^2
+//            = (1/M) sum_m (E_a - E_b)^2 + 2 (F_a - F_b)^2 + (G_a - G_b)^2.
+// L_iso pulls every phi_i towards an isometry of the flat domain, which a closed
+// surface cannot be; this pulls the shapes towards isometries of each other,
+// which articulated poses of one shape are, so a region of the domain covers
+// the same part (the same lengths and angles) on every shape.
+template <class T>
+Var metric_mismatch(Tape<T>& t, Var du_a, Var dv_a, Var du_b, Var dv_b);
+
 }  // namespace jsa

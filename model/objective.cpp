@@ -85,6 +85,14 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
     weighted.push_back({w.isometry, iso});
     out.isometry = double(t.scalar(iso));
   }
+  if (w.metric > 0 && jacobian && o.metric_reference >= 0 && shape != o.metric_reference) {
+    // L_metric (collections, beyond the paper; losses/isometry.h): the
+    // reference shape's phi at this shape's {x_P}, its metric against ours.
+    const SurfacePoints ref =
+        atlas.phi.evaluate(t, p, x_p, true, atlas.phi_code(t, o.metric_reference));
+    const Var metric = metric_mismatch(t, first_m(all.du), first_m(all.dv), ref.du, ref.dv);
+    weighted.push_back({w.metric, metric});
+  }
   if (c.repulsion) {
     // L_rep on the means   (Eq. 11)
     const Var rep = repulsion(t, p.on(t, atlas.domain.means()), atlas.domain.sigma(),

@@ -22,6 +22,7 @@ struct LossWeights {
   double isometry = 1e-4;  // l_iso, on L_iso (Eq. 10), mean convention
   double repulsion = 1.0;  // l_rep, on L_rep (Eq. 11)
   double code = 1e-4;      // collections: weight of the mean squared norm of the latent codes
+  double metric = 0;       // collections: on L_metric (beyond the paper; losses/isometry.h)
 };
 
 // Which parts of the method are on. The default is Table 1 row 11, the full method.
@@ -44,6 +45,9 @@ struct ObjectiveOptions {
   LossWeights weights;
   Components components;
   double repulsion_tolerance = 1e-7;  // bound on the error of L_rep from its cut-off
+  // Collections: the shape whose metric every other shape's is compared with
+  // by L_metric at the same domain points (-1: none).
+  int metric_reference = -1;
 };
 
 // Builds L_single of shape `shape` (0 for a single shape) on the tape and returns

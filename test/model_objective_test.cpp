@@ -22,12 +22,13 @@ Block<double> random_targets(Index n, double alpha, uint64_t seed) {
 
 double objective_value(Atlas<double>& atlas, const std::vector<Block<double>>& targets,
                        const Components& c, Tape<double>& tape, bool backward,
-                       const LossWeights& weights = {}) {
+                       const LossWeights& weights = {}, int metric_reference = -1) {
   Rng rng(99);  // the same draws every evaluation: the objective is a fixed function
   tape.clear();
   ObjectiveOptions o;
   o.components = c;
   o.weights = weights;
+  o.metric_reference = metric_reference;
   Var loss = collection_objective(tape, atlas, targets, 24, rng, o, nullptr);
   if (backward) {
     atlas.params.zero_grad();
@@ -337,4 +338,47 @@ TEST_CASE("objective: values of L_iso and both cycle terms on a linear atlas wit
   CHECK(moved.cycle_2d == Approx(d1 * d1 + d2 * d2).epsilon(1e-12));
   CHECK(moved.cycle_6d == Approx(a * a * d1 * d1 + b * b * d2 * d2).epsilon(1e-12));
   CHECK(moved.isometry == exact.isometry);  // psi does not enter L_iso
+}
+
+TEST_CASE("objective: L_metric is 0 for equal codes, and its gradient matches central differences",
+          "[objective]") {
+  AtlasOptions ao = small_atlas_options();
+  ao.shapes = 2;
+  ao.code_size = 4;
+  Atlas<double> atlas(ao);
+  Rng init(5);
+  atlas.initialize(init);
+  auto codes = atlas.params.value(atlas.params.find("codes.phi"));  // N x D
+  const std::vector<Block<double>> targets{random_targets(32, ao.alpha, 3),
+                                           random_targets(32, ao.alpha, 4)};
+  const Components c;
+  LossWeights off, on;
+  on.metric = 1.0;
+  Tape<double> tape;
+  // Equal codes: phi_1 = phi_0, so their metrics agree at every point.
+  codes.row(1) = codes.row(0);
+  CHECK(objective_value(atlas, targets, c, tape, false, on, 0) ==
+        Approx(objective_value(atlas, targets, c, tape, false, off, 0)).epsilon(1e-12));
+  // Codes that differ (larger than their N(0, 0.01^2) start): the term is on.
+  for (Index i = 0; i < codes.size(); ++i) codes.data()[i] = 0.3 * std::sin(1.0 + 3.0 * double(i));
+  const double with = objective_value(atlas, targets, c, tape, false, on, 0);
+  const double without = objective_value(atlas, targets, c, tape, false, off, 0);
+  CHECK(with > without);
+  // No reference shape: no term.
+  CHECK(objective_value(atlas, targets, c, tape, false, on, -1) == Approx(without).epsilon(1e-12));
+  objective_value(atlas, targets, c, tape, true, on, 0);
+  const std::vector<double> analytic = atlas.params.grads();
+  double worst = 0;
+  int checked = 0;
+  for (const char* name : {"codes.phi", "phi.wf", "phi.w0"}) {
+    const auto& e = atlas.params.entry(atlas.params.find(name));
+    worst = std::max(
+        worst, worst_central_difference(
+                   atlas, analytic, e.offset, e.offset + size_t(e.rows * e.cols), 3,
+                   [&]() { return objective_value(atlas, targets, c, tape, false, on, 0); },
+                   checked));
+  }
+  INFO(checked << " entries, worst error/tolerance " << worst);
+  CHECK(checked >= 20);
+  CHECK(worst <= 1.0);
 }

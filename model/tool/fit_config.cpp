@@ -56,6 +56,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
                   {"isometry", o.weights.isometry},
                   {"repulsion", o.weights.repulsion},
                   {"code", o.weights.code},
+                  {"metric", o.weights.metric},
                   {"convention", "mean over points (paper's 1/M factors folded in)"}};
   j["components"] = {{"normals", o.components.normals},
                      {"repulsion", o.components.repulsion},
@@ -129,6 +130,8 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   field(w, "weights.", "isometry", o.weights.isometry);
   field(w, "weights.", "repulsion", o.weights.repulsion);
   field(w, "weights.", "code", o.weights.code);
+  o.weights.metric = 0;  // later addition: absent = off, what older runs used
+  if (w.contains("metric")) field(w, "weights.", "metric", o.weights.metric);
   const json& c = j.contains("components") ? j["components"] : json();
   field(c, "components.", "normals", o.components.normals);
   field(c, "components.", "repulsion", o.components.repulsion);

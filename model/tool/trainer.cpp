@@ -35,7 +35,8 @@ static void validate(const FitOptions& o) {
       {o.weights.cycle, "weights.cycle must be >= 0 and finite"},
       {o.weights.isometry, "weights.isometry must be >= 0 and finite"},
       {o.weights.repulsion, "weights.repulsion must be >= 0 and finite"},
-      {o.weights.code, "weights.code must be >= 0 and finite"}};
+      {o.weights.code, "weights.code must be >= 0 and finite"},
+      {o.weights.metric, "weights.metric must be >= 0 and finite"}};
   for (const auto& [w, message] : weights) require(w >= 0 && std::isfinite(w), message);
   require(o.repulsion_tolerance > 0, "repulsion_tolerance must be positive");
   require(o.orient_every >= 0 && o.reseed_every >= 0 && o.wrap_steps >= 0,
@@ -336,6 +337,7 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
   }
   tape_.clear();
   ObjectiveOptions objective{options_.weights, options_.components, options_.repulsion_tolerance};
+  if (atlas_->shapes() > 1) objective.metric_reference = 0;  // L_metric against shape 0
   // The staged objective (FitOptions::chart_from): phi and P alone at first.
   if (double(iteration_) < options_.chart_from * double(options_.iterations))
     objective.components.chart = false;
