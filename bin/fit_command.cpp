@@ -53,6 +53,7 @@ struct FitArgs {
   // Whether --iters and --schedule were given: collections and --preset paper
   // have defaults of their own (kFixedScheduleIterations in model/tool/trainer.h).
   bool iters_given = false, schedule_given = false;
+  bool points_given = false, gaussians_given = false, width_given = false;
 };
 
 std::string format_duration(double seconds) {
@@ -172,6 +173,11 @@ void run_fit(FitArgs& a, Team& team) {
     const bool fixed_m = inputs.size() > 1 || !a.preset.empty();
     if (fixed_m && !a.schedule_given) o.schedule.kind = "step";
     if (fixed_m && !a.iters_given) o.iterations = kFixedScheduleIterations;
+    if (inputs.size() > 1 && a.preset.empty()) {  // trainer.h: sized for a laptop's minutes
+      if (!a.points_given) o.points = kCollectionPoints;
+      if (!a.gaussians_given) o.atlas.gaussians = kCollectionGaussians;
+      if (!a.width_given) o.atlas.width = kCollectionWidth;
+    }
   }
   if (a.threads >= 0) o.threads = a.threads;
   set_threads(o.threads);
@@ -650,14 +656,19 @@ void add_fit(CLI::App& app) {
                     std::to_string(kFixedScheduleIterations) + ")")
       ->capture_default_str()
       ->check(CLI::Range(int64_t(0), int64_t(100000000)));
-  c->add_option("--points,-M", o.points, "M: points sampled on P and on the shape per iteration")
+  c->add_option("--points,-M", o.points,
+                "M: points sampled on P and on the shape per iteration (collections: " +
+                    std::to_string(kCollectionPoints) + ")")
       ->capture_default_str()
       ->check(CLI::Range(Index(16), Index(1000000)));
   c->add_option("--gaussians,-K", o.atlas.gaussians,
-                "K: Gaussians in the domain P (sigma = 1/sqrt(K))")
+                "K: Gaussians in the domain P (sigma = 1/sqrt(K); collections: " +
+                    std::to_string(kCollectionGaussians) + ")")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000000));
-  c->add_option("--width", o.atlas.width, "Hidden units of phi and psi")
+  c->add_option("--width", o.atlas.width,
+                "Hidden units of phi and psi (collections: " + std::to_string(kCollectionWidth) +
+                    ")")
       ->capture_default_str()
       ->check(CLI::Range(4, 4096));
   c->add_option("--depth", o.atlas.hidden_layers, "Hidden layers of phi and psi")
@@ -844,6 +855,9 @@ void add_fit(CLI::App& app) {
   c->callback([a, c]() {
     a->iters_given = c->count("--iters") > 0;
     a->schedule_given = c->count("--schedule") > 0;
+    a->points_given = c->count("--points") > 0;
+    a->gaussians_given = c->count("--gaussians") > 0;
+    a->width_given = c->count("--width") > 0;
     std::unique_ptr<Team> team = join_team();
     if (team->size() == 1) return run_fit(*a, *team);
     try {

@@ -88,8 +88,12 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
   if (w.metric > 0 && jacobian && o.metric_reference >= 0 && shape != o.metric_reference) {
     // L_metric (collections, beyond the paper; losses/isometry.h): the
     // reference shape's phi at this shape's {x_P}, its metric against ours.
-    const SurfacePoints ref =
-        atlas.phi.evaluate(t, p, x_p, true, atlas.phi_code(t, o.metric_reference));
+    // The reference's code is held constant here: it is a target for the
+    // others, moved only by its own shape's terms (which also keeps a
+    // data-parallel step exact: a code's gradient stays on its shape's rank).
+    const Var ref_code =
+        t.constant(Block<T>(t.value(atlas.phi_code(t, o.metric_reference))));
+    const SurfacePoints ref = atlas.phi.evaluate(t, p, x_p, true, ref_code);
     const Var metric = metric_mismatch(t, first_m(all.du), first_m(all.dv), ref.du, ref.dv);
     weighted.push_back({w.metric, metric});
   }
