@@ -80,9 +80,9 @@ TEST_CASE("metric_mismatch: 0 for isometric pairs, the closed form for a stretch
   // against a shear (e1, s e1 + e2): E equal, F differs by s, G by s^2.
   Block<double> a1 = Block<double>::Zero(2, 3), a2 = Block<double>::Zero(2, 3);
   Block<double> b1 = Block<double>::Zero(2, 3), b2 = Block<double>::Zero(2, 3);
-  a1(0, 0) = 2, a2(0, 1) = 0.5;     // row 0: stretch (2, 0.5)
-  a1(1, 0) = 1, a2(1, 1) = 1;       // row 1: the identity
-  b1(0, 0) = 1, b2(0, 1) = 1;       // row 0: the identity
+  a1(0, 0) = 2, a2(0, 1) = 0.5;                // row 0: stretch (2, 0.5)
+  a1(1, 0) = 1, a2(1, 1) = 1;                  // row 1: the identity
+  b1(0, 0) = 1, b2(0, 1) = 1;                  // row 0: the identity
   b1(1, 0) = 1, b2(1, 0) = 0.3, b2(1, 1) = 1;  // row 1: shear s = 0.3
   const double row0 = std::pow(4.0 - 1, 2) + std::pow(0.25 - 1, 2);
   const double row1 = 2 * 0.3 * 0.3 + std::pow(0.09, 2);

@@ -378,11 +378,11 @@ TEST_CASE("objective: L_metric is 0 for equal codes, and its gradient matches ce
     const auto& e = atlas.params.entry(atlas.params.find(name));
     const size_t begin = std::string(name) == "codes.phi" ? e.offset + size_t(e.cols) : e.offset;
     worst = std::max(
-        worst, worst_central_difference(
-                   atlas, analytic, begin, e.offset + size_t(e.rows * e.cols),
-                   std::string(name) == "codes.phi" ? 1 : 3,
-                   [&]() { return objective_value(atlas, targets, c, tape, false, on, 0); },
-                   checked));
+        worst,
+        worst_central_difference(
+            atlas, analytic, begin, e.offset + size_t(e.rows * e.cols),
+            std::string(name) == "codes.phi" ? 1 : 3,
+            [&]() { return objective_value(atlas, targets, c, tape, false, on, 0); }, checked));
   }
   INFO(checked << " entries, worst error/tolerance " << worst);
   CHECK(checked >= 20);
