@@ -666,9 +666,9 @@ void add_fit(CLI::App& app) {
                     std::to_string(kCollectionGaussians) + ")")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000000));
-  c->add_option("--width", o.atlas.width,
-                "Hidden units of phi and psi (collections: " + std::to_string(kCollectionWidth) +
-                    ")")
+  c->add_option(
+       "--width", o.atlas.width,
+       "Hidden units of phi and psi (collections: " + std::to_string(kCollectionWidth) + ")")
       ->capture_default_str()
       ->check(CLI::Range(4, 4096));
   c->add_option("--depth", o.atlas.hidden_layers, "Hidden layers of phi and psi")
