@@ -42,10 +42,11 @@ struct FitOptions {
     // "lambda_cycle").
     weights.cycle = 0.1;
     // Collections: L_metric (beyond the paper; losses/isometry.h). At 10
-    // minutes on SHREC ants it carries keypoints 12.8 -> 10.2 x 1e-2 (chart
-    // rule); on teddies, not isometric to each other, 13.4 -> 14.0, within
-    // the seed spread (docs/collections.md, fourth round). No effect on a
-    // single shape.
+    // minutes on SHREC ants it carries keypoints 12.8 -> 11.4 and 11.7 -> 9.8
+    // x 1e-2 (chart rule, two seeds); on teddies, not isometric to each
+    // other, it leaves them level (13.4 -> 14.6, 13.6 -> 13.8) at a small cost
+    // in Chamfer (docs/collections.md, fourth round). No effect on a single
+    // shape.
     weights.metric = 1e-2;
   }
   AtlasOptions atlas;                          // K, network sizes, alpha
