@@ -385,6 +385,6 @@ TEST_CASE("objective: L_metric is 0 for equal codes, and its gradient matches ce
             [&]() { return objective_value(atlas, targets, c, tape, false, on, 0); }, checked));
   }
   INFO(checked << " entries, worst error/tolerance " << worst);
-  CHECK(checked >= 20);
+  CHECK(checked > 20);  // shape 1's code (4) and every 3rd weight of two layers
   CHECK(worst <= 1.0);
 }
