@@ -797,6 +797,10 @@ void add_fit(CLI::App& app) {
                 "(0: random start, as the paper; see model/heuristics/wrap.h)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1000000));
+  c->add_flag("--parallel-shapes,!--serial-shapes", o.parallel_shapes,
+              "Collections: split each step's shapes over the threads, a tape per thread "
+              "(--serial-shapes: one shape at a time, the threads inside each kernel)")
+      ->capture_default_str();
   c->add_option("--code-lr-scale", o.code_lr_scale,
                 "Collections: learning rate of the latent codes as a multiple of the networks'")
       ->capture_default_str()

@@ -31,8 +31,19 @@ void Parameters<T>::zero_grad() {
 template <class T>
 Var Parameters<T>::on(Tape<T>& t, int i) {
   Var v = t.variable(Block<T>(value(i)));
-  // dθ_i += d(node): the leaf hands its gradient to the flat buffer.
-  t.on_backward(v, [this, i](Tape<T>& t, Var v) { grad(i) += t.grad(v); });
+  // dθ_i += d(node): the leaf hands its gradient to the flat buffer, or to the
+  // tape's own buffer of the same layout when it has one (Tape::set_parameter_grads).
+  t.on_backward(v, [this, i](Tape<T>& t, Var v) {
+    std::vector<T>* own = t.parameter_grads();
+    if (!own) {
+      grad(i) += t.grad(v);
+      return;
+    }
+    JSA_CHECK(own->size() == grad_.size(), "a tape's gradient buffer of " << own->size()
+                                               << " numbers for " << grad_.size() << " parameters");
+    const Entry& e = entries_[size_t(i)];
+    Map(own->data() + e.offset, e.rows, e.cols) += t.grad(v);
+  });
   return v;
 }
 

@@ -102,6 +102,15 @@ class Tape {
     kept_size_ = 0;
   }
   int size() const { return size_; }
+
+  // Where parameter leaves (Parameters::on) add their gradients: nullptr, the
+  // default, means the Parameters' own buffer. Tapes that run backward() at
+  // the same time on one model each get a buffer of their own (the trainer's
+  // shape-parallel step), so no two threads add into the same numbers; the
+  // caller sums the buffers afterwards, in a fixed order.
+  void set_parameter_grads(std::vector<T>* grads) { parameter_grads_ = grads; }
+  std::vector<T>* parameter_grads() const { return parameter_grads_; }
+
   // Bytes held by node values and gradients (for memory reports).
   size_t bytes() const {
     size_t b = 0;
@@ -138,6 +147,7 @@ class Tape {
   int size_ = 0;
   std::vector<std::vector<int>> kept_;
   int kept_size_ = 0;
+  std::vector<T>* parameter_grads_ = nullptr;
 };
 
 }  // namespace jsa

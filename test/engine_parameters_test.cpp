@@ -61,6 +61,29 @@ TEST_CASE("on() hands the tape's gradient to the flat buffer", "[parameters]") {
   }
 }
 
+TEST_CASE("a tape with a gradient buffer of its own leaves the parameters' alone",
+          "[parameters]") {
+  Parameters<double> p;
+  p.add("a", 1, 2);
+  const int w = p.add("w", 2, 2);
+  p.values() = {9, 9, 1, 2, 3, 4};
+  Block<double> x(1, 2);
+  x << 1, -1;
+  std::vector<double> own(p.size(), 5.0);  // not zeroed: on() adds, the caller zeroes
+  Tape<double> t;
+  t.set_parameter_grads(&own);
+  p.zero_grad();
+  t.backward(sum(t, linear(t, t.constant(x), p.on(t, w), Var{})));
+  CHECK(own == std::vector<double>{5, 5, 6, 6, 4, 4});  // w's rows at its offset, 2 on
+  CHECK(p.grads() == std::vector<double>(6, 0.0));
+  // A buffer of another layout is an error, not a write past its end.
+  std::vector<double> short_buffer(3, 0.0);
+  t.clear();
+  t.set_parameter_grads(&short_buffer);
+  const Var loss = sum(t, linear(t, t.constant(x), p.on(t, w), Var{}));
+  CHECK_THROWS_WITH(t.backward(loss), Catch::Contains("gradient buffer of 3 numbers"));
+}
+
 TEST_CASE("save then load restores every value", "[parameters][io]") {
   const Parameters<float> a = two_layer();
   Parameters<float> b;

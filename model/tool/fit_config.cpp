@@ -87,6 +87,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["template_share"] = o.template_share;
   j["chart_from"] = o.chart_from;
   j["code_lr_scale"] = o.code_lr_scale;
+  j["parallel_shapes"] = o.parallel_shapes;
   j["pool"] = o.pool;
   j["threads"] = o.threads;
   return j.dump(indent);
@@ -186,6 +187,8 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (j.contains("code_lr_scale")) field(j, "", "code_lr_scale", o.code_lr_scale);
   if (!(o.code_lr_scale > 0) || !std::isfinite(o.code_lr_scale))
     throw InputError(what + ": code_lr_scale must be positive");
+  o.parallel_shapes = false;  // later addition: runs before it took one shape at a time
+  if (j.contains("parallel_shapes")) field(j, "", "parallel_shapes", o.parallel_shapes);
   o.chart_from = 0;
   if (j.contains("chart_from")) field(j, "", "chart_from", o.chart_from);
   if (!(o.chart_from >= 0 && o.chart_from <= 1))

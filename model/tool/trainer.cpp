@@ -6,11 +6,13 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <exception>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <tuple>
 
+#include "engine/parallel.h"
 #include "model/heuristics/orientation.h"
 #include "model/heuristics/reseed.h"
 
@@ -320,31 +322,93 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
   for (Block<float>& t : targets_) t.resize(points, 6);  // a no-op within a level of the ramp
   shape_rngs_.clear();
   for (int s : local_) shape_rngs_.emplace_back(key, uint64_t(s));
-  ObjectiveShare<float> share;
-  share.shapes = local_;
-  share.batch = b;
-  share.repulsion = first_shape_ == 0;  // rank 0: N l_rep L_rep is counted once
-  share.code_begin = first_shape_;
-  share.code_end = last_shape_;
   // M targets {x_S, n_S} per shape, drawn with replacement from its pool.
   for (size_t k = 0; k < local_.size(); ++k) {
     const Block<float>& pool = pools_[size_t(local_[k])];
     Rng& rng = shape_rngs_[k];
     for (Index m = 0; m < points; ++m)
       targets_[k].row(m) = pool.row(Index(rng.below(uint64_t(pool.rows()))));
-    share.rngs.push_back(&rng);
-    if (!surfaces_.empty()) share.surfaces.push_back(&surfaces_[size_t(local_[k] - first_shape_)]);
   }
-  tape_.clear();
   ObjectiveOptions objective{options_.weights, options_.components, options_.repulsion_tolerance};
   if (atlas_->shapes() > 1) objective.metric_reference = 0;  // L_metric against shape 0
   // The staged objective (FitOptions::chart_from): phi and P alone at first.
   if (double(iteration_) < options_.chart_from * double(options_.iterations))
     objective.components.chart = false;
-  LossTerms sums;
-  Var loss = objective_share(tape_, *atlas_, targets_, points, objective, share, &sums);
+
+  // L_full is a sum over shapes (Eq. 12), so its gradient is too: the step's
+  // shapes are split into `workers` consecutive groups, each group's share of
+  // L_full is built and differentiated on a tape of its own by one thread
+  // (the same split an MPI run makes over ranks, docs/mpi.md), and the
+  // groups' gradients are summed in group order. Worker 0 also adds L_rep and
+  // the codes' prior. One worker is the plain step.
+  const int count = int(local_.size());
+  const int workers =
+      options_.parallel_shapes && count > 1 ? std::max(1, std::min(max_threads(), count)) : 1;
+  if (int(worker_tapes_.size()) < workers - 1) {
+    worker_tapes_.resize(size_t(workers - 1));
+    worker_grads_.resize(size_t(workers - 1));
+  }
+  worker_targets_.resize(size_t(workers));
+  std::vector<LossTerms> part(static_cast<size_t>(workers));
+  std::vector<std::exception_ptr> failure(static_cast<size_t>(workers));
   atlas_->params.zero_grad();
-  tape_.backward(loss);
+  auto work = [&](int w) {
+    const int begin = count * w / workers, end = count * (w + 1) / workers;
+    ObjectiveShare<float> share;
+    share.batch = b;
+    share.repulsion = first_shape_ == 0 && w == 0;  // rank 0: N l_rep L_rep is counted once
+    share.code_begin = w == 0 ? first_shape_ : 0;
+    share.code_end = w == 0 ? last_shape_ : 0;
+    std::vector<Block<float>>& own = worker_targets_[size_t(w)];
+    if (workers > 1) own.resize(size_t(end - begin));
+    for (int k = begin; k < end; ++k) {
+      share.shapes.push_back(local_[size_t(k)]);
+      share.rngs.push_back(&shape_rngs_[size_t(k)]);
+      if (!surfaces_.empty())
+        share.surfaces.push_back(&surfaces_[size_t(local_[size_t(k)] - first_shape_)]);
+      if (workers > 1) own[size_t(k - begin)] = targets_[size_t(k)];  // storage kept between steps
+    }
+    const std::vector<Block<float>>& targets = workers > 1 ? own : targets_;
+    Tape<float>& tape = w == 0 ? tape_ : worker_tapes_[size_t(w - 1)];
+    if (w > 0) {
+      std::vector<float>& grads = worker_grads_[size_t(w - 1)];
+      grads.assign(atlas_->params.size(), 0.0f);
+      tape.set_parameter_grads(&grads);
+    }
+    tape.clear();
+    const Var loss = objective_share(tape, *atlas_, targets, points, objective, share,
+                                     &part[size_t(w)]);
+    tape.backward(loss);
+  };
+  if (workers == 1) {
+    work(0);
+  } else {
+#pragma omp parallel for num_threads(workers) schedule(static, 1)
+    for (int w = 0; w < workers; ++w) {
+      try {
+        work(w);
+      } catch (...) {
+        failure[size_t(w)] = std::current_exception();  // nothing may leave an OpenMP region
+      }
+    }
+    for (const std::exception_ptr& e : failure)
+      if (e) std::rethrow_exception(e);
+    std::vector<float>& grads = atlas_->params.grads();
+    for (int w = 1; w < workers; ++w) {
+      const std::vector<float>& g = worker_grads_[size_t(w - 1)];
+      for (size_t i = 0; i < grads.size(); ++i) grads[i] += g[i];
+    }
+  }
+  LossTerms sums;
+  for (const LossTerms& p : part) {
+    sums.total += p.total;
+    sums.surface += p.surface;
+    sums.chart += p.chart;
+    sums.cycle_2d += p.cycle_2d;
+    sums.cycle_6d += p.cycle_6d;
+    sums.isometry += p.isometry;
+    sums.repulsion += p.repulsion;
+  }
   // The test hook counts joint iterations only (the template start has none).
   if (!template_step && counter == fault_at_ && faults_to_inject_ > 0) {
     --faults_to_inject_;

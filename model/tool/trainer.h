@@ -105,6 +105,12 @@ struct FitOptions {
   // Share of the run's cost spent on the template (when template_steps < 0).
   // `jsatlas fit` starts collections with -1 and 0.3 (docs/collections.md).
   double template_share = 0;
+  // Collections: a step's shapes split over the threads, each thread with a
+  // tape and a gradient of its own, summed in thread order (Trainer::train_on).
+  // At a collection's sizes (M = 1000 rows, 64 units) one shape's kernels are
+  // too small to share between threads; whole shapes are not. false: every
+  // shape in turn, the threads inside each kernel (the single-shape way).
+  bool parallel_shapes = true;
 };
 
 // The paper's method (Sec. 3) and nothing beyond it: ReLU MLPs, normals scaled
@@ -309,6 +315,12 @@ class Trainer {
   std::unique_ptr<Atlas<float>> atlas_;
   Adam<float> adam_;
   Tape<float> tape_;
+  // The shape-parallel step (FitOptions::parallel_shapes): tapes and gradient
+  // buffers of the threads after the first (the first uses tape_ and the
+  // parameters' own gradient).
+  std::vector<Tape<float>> worker_tapes_;
+  std::vector<std::vector<float>> worker_grads_;
+  std::vector<std::vector<Block<float>>> worker_targets_;  // each thread's copy of its targets
   Rng rng_;
   int64_t iteration_ = 0;
   LossTerms last_;
