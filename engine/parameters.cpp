@@ -39,8 +39,9 @@ Var Parameters<T>::on(Tape<T>& t, int i) {
       grad(i) += t.grad(v);
       return;
     }
-    JSA_CHECK(own->size() == grad_.size(), "a tape's gradient buffer of " << own->size()
-                                               << " numbers for " << grad_.size() << " parameters");
+    JSA_CHECK(own->size() == grad_.size(), "a tape's gradient buffer of "
+                                               << own->size() << " numbers for " << grad_.size()
+                                               << " parameters");
     const Entry& e = entries_[size_t(i)];
     Map(own->data() + e.offset, e.rows, e.cols) += t.grad(v);
   });

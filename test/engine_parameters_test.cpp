@@ -61,8 +61,7 @@ TEST_CASE("on() hands the tape's gradient to the flat buffer", "[parameters]") {
   }
 }
 
-TEST_CASE("a tape with a gradient buffer of its own leaves the parameters' alone",
-          "[parameters]") {
+TEST_CASE("a tape with a gradient buffer of its own leaves the parameters' alone", "[parameters]") {
   Parameters<double> p;
   p.add("a", 1, 2);
   const int w = p.add("w", 2, 2);

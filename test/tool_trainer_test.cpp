@@ -1,7 +1,7 @@
 // The training loop: same seed -> same run; a resumed run follows the same
 // trajectory bit for bit; and a small atlas actually learns a sphere.
-#include <catch2/catch.hpp>
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <fstream>
 #include <iterator>

@@ -376,8 +376,8 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
       tape.set_parameter_grads(&grads);
     }
     tape.clear();
-    const Var loss = objective_share(tape, *atlas_, targets, points, objective, share,
-                                     &part[size_t(w)]);
+    const Var loss =
+        objective_share(tape, *atlas_, targets, points, objective, share, &part[size_t(w)]);
     tape.backward(loss);
   };
   if (workers == 1) {
