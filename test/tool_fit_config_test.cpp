@@ -121,6 +121,19 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   CHECK(legacy.atlas.softplus_beta == 0);
   CHECK(message_of(edited("\"batch_shapes\":0", "\"batch_shapes\":-2")) ==
         "run/model.ckpt: sizes must be positive");
+  // Shapes split over threads (a later addition): kept both ways, and a run
+  // from before it took one shape at a time.
+  for (const bool split : {true, false}) {
+    jsa::FitOptions p;
+    p.parallel_shapes = split;
+    CHECK(jsa::fit_options_from_json(jsa::fit_options_to_json(p), "x").parallel_shapes == split);
+  }
+  std::string before_split = jsa::fit_options_to_json(jsa::FitOptions{}, -1);
+  const std::string key = ",\"parallel_shapes\":true";
+  const auto at = before_split.find(key);
+  REQUIRE(at != std::string::npos);
+  before_split.erase(at, key.size());
+  CHECK(!jsa::fit_options_from_json(before_split, "old").parallel_shapes);
 }
 
 TEST_CASE("fit config: malformed JSON is rejected naming the source and the field",

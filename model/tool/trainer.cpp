@@ -349,6 +349,7 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
     worker_grads_.resize(size_t(workers - 1));
   }
   worker_targets_.resize(size_t(workers));
+  shape_threads_ = workers;
   std::vector<LossTerms> part(static_cast<size_t>(workers));
   std::vector<std::exception_ptr> failure(static_cast<size_t>(workers));
   atlas_->params.zero_grad();

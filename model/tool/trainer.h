@@ -293,6 +293,8 @@ class Trainer {
   // The shapes [first, last) this rank trains (all of them in one process).
   std::pair<int, int> shape_block() const { return {first_shape_, last_shape_}; }
   Tape<float>& tape() { return tape_; }
+  // Threads the last step's shapes were split over (FitOptions::parallel_shapes; 1: none).
+  int shape_threads() const { return shape_threads_; }
 
   // Shape s's pool as the trainer holds it (P x 6, normals scaled by alpha;
   // empty for a shape of another rank's block).
@@ -321,6 +323,7 @@ class Trainer {
   std::vector<Tape<float>> worker_tapes_;
   std::vector<std::vector<float>> worker_grads_;
   std::vector<std::vector<Block<float>>> worker_targets_;  // each thread's copy of its targets
+  int shape_threads_ = 1;
   Rng rng_;
   int64_t iteration_ = 0;
   LossTerms last_;
