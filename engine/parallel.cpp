@@ -3,15 +3,46 @@
 #include <omp.h>
 
 #include <Eigen/Core>
+#include <cstdlib>
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
 
 namespace jsa {
 
 int max_threads() { return omp_get_max_threads(); }
 
+namespace {
+// MXCSR bits: FTZ (bit 15) makes results below 2^-126 zero, DAZ (bit 6) reads
+// such inputs as zero.
+constexpr unsigned kFlushToZero = 0x8000, kDenormalsAreZero = 0x0040;
+
+void flush_denormals_here() {
+#if defined(__SSE__)
+  _mm_setcsr(_mm_getcsr() | kFlushToZero | kDenormalsAreZero);
+#endif
+}
+}  // namespace
+
+bool denormals_flushed() {
+#if defined(__SSE__)
+  const unsigned both = kFlushToZero | kDenormalsAreZero;
+  return (_mm_getcsr() & both) == both;
+#else
+  return false;
+#endif
+}
+
 void set_threads(int n) {
-  if (n <= 0) return;
-  omp_set_num_threads(n);
-  Eigen::setNbThreads(n);
+  if (n > 0) {
+    omp_set_num_threads(n);
+    Eigen::setNbThreads(n);
+  }
+  if (std::getenv("JSATLAS_KEEP_DENORMALS")) return;
+  // Each thread has its own MXCSR; threads started later copy their creator's.
+  flush_denormals_here();
+#pragma omp parallel
+  flush_denormals_here();
 }
 
 }  // namespace jsa

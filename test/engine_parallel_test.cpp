@@ -1,6 +1,10 @@
 // Tests of engine/parallel.h: parallel_rows covers [0, n) exactly once in
 // grain-sized ranges, whatever n is relative to the grain.
+#include <omp.h>
+
 #include <catch2/catch.hpp>
+#include <cstdlib>
+#include <limits>
 #include <vector>
 
 #include "engine/parallel.h"
@@ -32,6 +36,25 @@ TEST_CASE("set_threads(0) keeps the thread count", "[parallel]") {
   CHECK(before >= 1);
   set_threads(0);
   CHECK(max_threads() == before);
+}
+
+TEST_CASE("set_threads turns denormal floats off on every thread", "[parallel]") {
+  if (std::getenv("JSATLAS_KEEP_DENORMALS")) return;  // the comparison switch is set
+  set_threads(2);
+  // 2^-126 is the smallest normal float; half of it is a denormal unless flushed.
+  volatile float smallest = std::numeric_limits<float>::min();
+  volatile float half = 0.5f;
+  CHECK(denormals_flushed());
+  CHECK(smallest * half == 0.0f);
+  std::vector<int> flushed(16, -1);
+#pragma omp parallel num_threads(2)
+  {
+    const int id = omp_get_thread_num();
+    if (id < 16) flushed[size_t(id)] = denormals_flushed() && smallest * half == 0.0f ? 1 : 0;
+  }
+  CHECK(flushed[0] == 1);
+  CHECK(flushed[1] == 1);
+  set_threads(0);
 }
 
 }  // namespace jsa
