@@ -7,7 +7,9 @@
 //     random offset; NAME.vts beside NAME.obj is copied with its x y z turned
 //     the same way (the vertex indices stay valid: the lines keep their order).
 //     DIR/applied_rotations.json lists A_i (rows: x' = x A_i + t_i).
-//   bench_rotate_shapes align [--trim 1,0.7,0.5] [--seed S] A.obj B.obj ...   (the pose step alone)
+//   bench_rotate_shapes align [--trim 1,0.7,0.5] [--normal-weight 0,0.08] [--seed S] A.obj B.obj
+//   ...
+//                                                     (the pose step alone)
 //   bench_rotate_shapes compare --applied DIR/applied_rotations.json --found RUN/rotations.json
 //                               [--reference RUN0/rotations.json]
 //     the angle between the rotation the fit found for each copy and the one
@@ -129,6 +131,12 @@ int main(int argc, char** argv) {
   double tie = jsa::RigidAlignOptions{}.tie;
   al->add_option("--tie", tie, "RigidAlignOptions::tie (0: the lowest Chamfer only)")
       ->capture_default_str();
+  std::vector<double> normal_weights{0.0};
+  al->add_option("--normal-weight", normal_weights,
+                 "RigidAlignOptions::normal_weight, comma-separated (0: points only)")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->capture_default_str();
   al->add_option("--seed", seed, "Seed of the surface samples")->capture_default_str();
   al->add_option("--applied", applied,
                  "applied_rotations.json of the inputs (rotate's): print each angle error");
@@ -167,27 +175,30 @@ int main(int argc, char** argv) {
       std::vector<Eigen::Matrix3d> a;
       if (!applied.empty()) a = read_rotations(applied, "shapes", "rotation");
       if (!a.empty() && a.size() != shapes.size()) throw std::runtime_error("shape counts differ");
-      for (const double trim : trims) {
-        std::printf("trim %.2f:\n", trim);
-        for (size_t i = 1; i < shapes.size(); ++i) {
-          jsa::RigidAlignOptions o;
-          o.keep_input = 0;
-          o.trim = trim;
-          o.tie = tie;
-          const jsa::RigidAlignment r =
-              jsa::rigid_align(shapes[i].pool.leftCols(3), shapes[0].pool.leftCols(3), o);
-          std::printf(
-              "  %s: %.1f deg, score %.2f, runner-up %.2f (x 1e-4, margin %.2f), %d tied%s\n",
-              fs::path(inputs[i]).filename().c_str(), r.angle_degrees(), 1e4 * r.chamfer,
-              1e4 * r.runner_up, r.runner_up / r.chamfer, r.tied,
-              r.tie_broken ? ", tie broken by ball shares" : "");
-          // The stored shapes are taken as aligned: posed i goes onto posed 0 by A_i^T A_0.
-          if (!a.empty())
+      for (const double weight : normal_weights)
+        for (const double trim : trims) {
+          std::printf("trim %.2f, normal weight %.3f:\n", trim, weight);
+          for (size_t i = 1; i < shapes.size(); ++i) {
+            jsa::RigidAlignOptions o;
+            o.keep_input = 0;
+            o.trim = trim;
+            o.tie = tie;
+            o.normal_weight = weight;
+            const jsa::Index c = weight > 0 ? 6 : 3;
+            const jsa::RigidAlignment r =
+                jsa::rigid_align(shapes[i].pool.leftCols(c), shapes[0].pool.leftCols(c), o);
             std::printf(
-                "    error %.1f deg\n",
-                jsa::rotation_angle_degrees(r.rotation.transpose() * a[i].transpose() * a[0]));
+                "  %s: %.1f deg, score %.2f, runner-up %.2f (x 1e-4, margin %.2f), %d tied%s\n",
+                fs::path(inputs[i]).filename().c_str(), r.angle_degrees(), 1e4 * r.chamfer,
+                1e4 * r.runner_up, r.runner_up / r.chamfer, r.tied,
+                r.tie_broken ? ", tie broken by ball shares" : "");
+            // The stored shapes are taken as aligned: posed i goes onto posed 0 by A_i^T A_0.
+            if (!a.empty())
+              std::printf(
+                  "    error %.1f deg\n",
+                  jsa::rotation_angle_degrees(r.rotation.transpose() * a[i].transpose() * a[0]));
+          }
         }
-      }
     } else {
       const auto a = read_rotations(applied, "shapes", "rotation");
       const auto r = read_rotations(found, "shapes", "rotation");

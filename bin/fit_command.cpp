@@ -525,8 +525,9 @@ void run_fit(FitArgs& a, Team& team) {
     // cost model, and a machine whose load changes (or a model that is off)
     // would overrun it. Every `recheck` steps, the time per unit of modelled
     // cost over the last stretch re-estimates what is left; until the first
-    // learning-rate decay the run is shortened to fit (never lengthened), and
-    // past the budget it stops where it is. Ranks decide on rank 0's numbers.
+    // learning-rate decay the run is shortened to fit, or at a fixed M
+    // lengthened when the steps got cheaper (budgeted_iterations), and past
+    // the budget it stops where it is. Ranks decide on rank 0's numbers.
     if (budgeted && sized && trainer.iteration() - recheck_from >= recheck && !trainer.finished()) {
       const auto now = clock::now();
       const int64_t i = trainer.iteration(), n = o.iterations;
@@ -541,13 +542,14 @@ void run_fit(FitArgs& a, Team& team) {
       int64_t fit_n = budgeted_iterations(o.schedule, o.points, kStepOverheadPoints, i, n,
                                           first_decay, per_cost, left);
       fit_n = int64_t(rank0_value(double(fit_n)));
-      if (fit_n < n) {
+      if (fit_n != n) {
         trainer.set_iterations(fit_n);
         o.iterations = fit_n;
         if (!a.quiet)
           std::cerr << "fit: " << per_cost * (kStepOverheadPoints + double(o.points)) * 1e3
-                    << " ms per full step now; the run is shortened to " << fit_n
-                    << " iterations to keep --minutes " << a.minutes << "\n";
+                    << " ms per full step now; the run is "
+                    << (fit_n < n ? "shortened" : "lengthened") << " to " << fit_n
+                    << " iterations to fill --minutes " << a.minutes << "\n";
       }
       recheck_from = i;
       recheck_time = now;

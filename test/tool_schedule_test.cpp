@@ -211,7 +211,7 @@ TEST_CASE("schedule: out-of-range settings are refused naming the setting", "[sc
   CHECK_THROWS_WITH(jsa::Trainer(o, pool), "schedule.levels must be in [1, 1000]");
 }
 
-TEST_CASE("budgeted_iterations: a run is shortened to what is left, never lengthened",
+TEST_CASE("budgeted_iterations: a run is shortened to what is left, lengthened only at fixed M",
           "[tool][schedule]") {
   jsa::ScheduleOptions ramp;  // the default: M from 625 to 2500 over 3/4 of the run
   const jsa::Index m = 2500;
@@ -231,8 +231,23 @@ TEST_CASE("budgeted_iterations: a run is shortened to what is left, never length
   const double more =
       jsa::scheduled_mean_cost(ramp, m, overhead, 100, k + 1, k + 1) * double(k + 1 - 100);
   CHECK(more * 2e-3 > 0.97 * rest * 1e-3);
-  // Cheaper steps than planned: never lengthened.
+  // Cheaper steps than planned, under the ramp: not lengthened (M would go back down).
   CHECK(jsa::budgeted_iterations(ramp, m, overhead, 100, n, decay, 1e-4, rest * 1e-3) == n);
+  // At a fixed M (collections, --preset paper): lengthened to the longest run
+  // whose rest fits in 97% of what is left, at most four times the rest.
+  jsa::ScheduleOptions step;
+  step.kind = "step";
+  const double cost = jsa::scheduled_mean_cost(step, m, overhead, 100, n, n);  // per step
+  const int64_t longer =
+      jsa::budgeted_iterations(step, m, overhead, 100, n, decay, 1e-3, 2.0 * cost * 900 * 1e-3);
+  CHECK(longer == 100 + int64_t(0.97 * 2.0 * 900));  // twice the time: about twice the rest
+  CHECK(jsa::budgeted_iterations(step, m, overhead, 100, n, decay, 1e-3,
+                                 100.0 * cost * 900 * 1e-3) == 100 + 4 * 900);
+  // Within 90-102% of what is left: unchanged (no back and forth).
+  CHECK(jsa::budgeted_iterations(step, m, overhead, 100, n, decay, 1e-3,
+                                 1.05 * cost * 900 * 1e-3) == n);
+  // Past the first decay, not lengthened either.
+  CHECK(jsa::budgeted_iterations(step, m, overhead, 800, n, decay, 1e-3, 100.0) == n);
   // Past the first decay the length stays (moving the decays would break the schedule) ...
   CHECK(jsa::budgeted_iterations(ramp, m, overhead, 800, n, decay, 2e-3, 1.0) == n);
   // ... and once the budget is spent the run ends where it is.

@@ -32,6 +32,8 @@ Eigen::Matrix3d kabsch(const Eigen::Matrix3d& h) {
   return svd.matrixU() * d * svd.matrixV().transpose();
 }
 
+// The sets as the search sees them: N x 3 points, or N x 6 rows [x, w n] with
+// the normals scaled by RigidAlignOptions::normal_weight.
 struct Sets {
   const Block<double>& moving;
   const Block<double>& fixed;
@@ -39,6 +41,21 @@ struct Sets {
   const NearestIndex<double>& fixed_index;
   double trim;  // RigidAlignOptions::trim
 };
+
+// Rows turned by r: the points, and the normals with them.
+Block<double> posed(const Block<double>& rows, const Eigen::Matrix3d& r) {
+  Block<double> out(rows.rows(), rows.cols());
+  for (Index c = 0; c < rows.cols(); c += 3) out.middleCols(c, 3) = rows.middleCols(c, 3) * r;
+  return out;
+}
+
+// sum x^T y over a pair of rows, each 3-column group with its own: the
+// cross-covariance whose Kabsch rotation minimises sum |x R - y|^2 + |w n R - w m|^2.
+void add_pair(Eigen::Matrix3d& h, const Block<double>& a, Index i, const Block<double>& b,
+              Index j) {
+  for (Index c = 0; c < a.cols(); c += 3)
+    h += a.row(i).segment(c, 3).transpose() * b.row(j).segment(c, 3);
+}
 
 // The pairs one direction keeps: all of them, or the `trim` share closest.
 // Returns the mean squared distance over the kept pairs; keep[i] says which.
@@ -73,18 +90,18 @@ double chamfer_and_update(const Sets& s, const Eigen::Matrix3d& r, Eigen::Matrix
   std::vector<int> nn;
   std::vector<double> d2;
   std::vector<char> keep;
-  const Block<double> moved = s.moving * r;
+  const Block<double> moved = posed(s.moving, r);
   s.fixed_index.query(moved, nn, &d2);
   const double forward = kept_pairs(d2, s.trim, keep);
   Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
   for (Index i = 0; i < moved.rows(); ++i)
-    if (keep[size_t(i)]) h += s.moving.row(i).transpose() * s.fixed.row(nn[size_t(i)]);
+    if (keep[size_t(i)]) add_pair(h, s.moving, i, s.fixed, nn[size_t(i)]);
   // |x R - y| = |x - y R^T|: the fixed points' neighbours among the unmoved ones.
-  const Block<double> back = s.fixed * r.transpose();
+  const Block<double> back = posed(s.fixed, r.transpose());
   s.moving_index.query(back, nn, &d2);
   const double backward = kept_pairs(d2, s.trim, keep);
   for (Index j = 0; j < back.rows(); ++j)
-    if (keep[size_t(j)]) h += s.moving.row(nn[size_t(j)]).transpose() * s.fixed.row(j);
+    if (keep[size_t(j)]) add_pair(h, s.moving, nn[size_t(j)], s.fixed, j);
   if (next) *next = kabsch(h);
   return forward + backward;
 }
@@ -139,8 +156,8 @@ double share_mismatch(const Sets& s, const Eigen::Matrix3d& r, const Block<doubl
         ++pairs;
       }
   };
-  one_way(s.moving * r, moving_shares, s.fixed_index, fixed_shares);
-  one_way(s.fixed * r.transpose(), fixed_shares, s.moving_index, moving_shares);
+  one_way(posed(s.moving, r), moving_shares, s.fixed_index, fixed_shares);
+  one_way(posed(s.fixed, r.transpose()), fixed_shares, s.moving_index, moving_shares);
   return sum / double(pairs);
 }
 
@@ -155,21 +172,28 @@ double RigidAlignment::angle_degrees() const { return rotation_angle_degrees(rot
 
 RigidAlignment rigid_align(const Block<double>& moving_all, const Block<double>& fixed_all,
                            const RigidAlignOptions& o) {
-  JSA_CHECK(moving_all.cols() == 3 && fixed_all.cols() == 3, "rigid_align takes N x 3 points");
+  const Index columns = o.normal_weight > 0 ? 6 : 3;
+  JSA_CHECK(moving_all.cols() == columns && fixed_all.cols() == columns,
+            "rigid_align takes N x "
+                << columns << (columns == 6 ? " rows (points, unit normals)" : " points"));
   JSA_CHECK(moving_all.rows() >= 4 && fixed_all.rows() >= 4,
             "rigid_align needs at least 4 points per set");
   JSA_CHECK(o.samples >= 4 && o.icp_iterations >= 0 && o.final_iterations >= 0 && o.trim > 0 &&
-                o.trim <= 1,
+                o.trim <= 1 && o.normal_weight >= 0,
             "bad rigid_align options");
-  const Block<double> moving = moving_all.topRows(std::min(o.samples, moving_all.rows()));
-  const Block<double> fixed = fixed_all.topRows(std::min(o.samples, fixed_all.rows()));
+  Block<double> moving = moving_all.topRows(std::min(o.samples, moving_all.rows()));
+  Block<double> fixed = fixed_all.topRows(std::min(o.samples, fixed_all.rows()));
+  if (columns == 6) {
+    moving.rightCols(3) *= o.normal_weight;
+    fixed.rightCols(3) *= o.normal_weight;
+  }
   const NearestIndex<double> moving_index(moving), fixed_index(fixed);
   const Sets sets{moving, fixed, moving_index, fixed_index, o.trim};
 
   Eigen::Matrix3d vm, vf;
   Eigen::Vector3d lm, lf;
-  principal_axes(moving, vm, lm);
-  principal_axes(fixed, vf, lf);
+  principal_axes(moving.leftCols(3), vm, lm);
+  principal_axes(fixed.leftCols(3), vf, lf);
   // Axes a and b may be exchanged when their eigenvalues are close in either set.
   auto close = [&](int a, int b) {
     for (const Eigen::Vector3d* l : {&lm, &lf}) {
@@ -239,7 +263,8 @@ RigidAlignment rigid_align(const Block<double>& moving_all, const Block<double>&
     }
     out.tied = int(tied.size());
     if (tied.size() > 1) {
-      const Block<double> moving_shares = ball_shares(moving), fixed_shares = ball_shares(fixed);
+      const Block<double> moving_shares = ball_shares(moving.leftCols(3)),
+                          fixed_shares = ball_shares(fixed.leftCols(3));
       double least = share_mismatch(sets, refined[best], moving_shares, fixed_shares);
       const size_t lowest = best;
       for (size_t t = 1; t < tied.size(); ++t) {

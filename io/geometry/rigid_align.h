@@ -54,6 +54,13 @@ struct RigidAlignOptions {
   // turns 5 of 9 poses right where the lowest Chamfer turns 3, but it turns a
   // shape with a moved limb end to end (docs/collections.md).
   double tie = 0;
+  // > 0: the sets are N x 6 rows (points, unit normals), and the normals,
+  // scaled by this weight, join the points in the nearest pairs, the Kabsch
+  // update and the score, which is then the 6D Chamfer of L_6D (Eq. 6) between
+  // [x, w n] rows. A pose that puts surface on surface facing the other way
+  // (an ant's abdomen on another's head, end to end) scores worse than with
+  // the points alone. 0: points only (N x 3 sets).
+  double normal_weight = 0;
 };
 
 struct RigidAlignment {

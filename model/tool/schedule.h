@@ -88,11 +88,20 @@ inline double scheduled_cost_ratio(const ScheduleOptions& s, Index points, doubl
 // Keeping a time budget mid-run (`jsatlas fit --minutes`): at iteration i of
 // a run of n, with `seconds_per_cost` measured over the last steps (seconds
 // per unit of modelled cost, overhead + M) and `seconds_left` of the budget,
-// the length the run should have: i when the budget is spent; n when the rest
-// fits (within 2%) or the first decay (`first_decay`, an iteration) is passed,
-// since moving the decays then would break the schedule; else the longest
-// length whose rest fits in 97% of what is left (at least i + 1). Never more
-// than n: a run is shortened, not lengthened.
+// the length the run should have:
+//   - i when the budget is spent;
+//   - n past the first decay (`first_decay`, an iteration), since moving the
+//     decays then would break the schedule;
+//   - shorter when the rest does not fit (more than 102% of what is left):
+//     the longest length whose rest fits in 97% of it (at least i + 1);
+//   - longer when the steps have become cheaper than planned (the rest needs
+//     under 90% of what is left), at a fixed M only (`s.kind == "step"`; under
+//     the ramp a longer run would take M back down a level): the longest length
+//     whose rest fits in 97% of what is left, at most four times the rest;
+//   - else n.
+// The first estimate of a run is made from its first steps, and a machine
+// whose load drops afterwards (or steps that get cheaper as the model
+// trains) would otherwise leave part of the budget unused.
 inline int64_t budgeted_iterations(const ScheduleOptions& s, Index points, double overhead,
                                    int64_t i, int64_t n, int64_t first_decay,
                                    double seconds_per_cost, double seconds_left) {
@@ -100,16 +109,22 @@ inline int64_t budgeted_iterations(const ScheduleOptions& s, Index points, doubl
   auto cost_left = [&](int64_t m) {
     return scheduled_mean_cost(s, points, overhead, i, m, m) * double(m - i);
   };
-  if (i >= first_decay || cost_left(n) * seconds_per_cost <= 1.02 * seconds_left) return n;
-  int64_t lo = i + 1, hi = n;
-  while (lo < hi) {
-    const int64_t mid = lo + (hi - lo + 1) / 2;
-    if (cost_left(mid) * seconds_per_cost <= 0.97 * seconds_left)
-      lo = mid;
-    else
-      hi = mid - 1;
-  }
-  return lo;
+  if (i >= first_decay) return n;
+  const double need = cost_left(n) * seconds_per_cost;
+  // The longest length in [lo, hi] whose rest fits in 97% of what is left.
+  auto longest = [&](int64_t lo, int64_t hi) {
+    while (lo < hi) {
+      const int64_t mid = lo + (hi - lo + 1) / 2;
+      if (cost_left(mid) * seconds_per_cost <= 0.97 * seconds_left)
+        lo = mid;
+      else
+        hi = mid - 1;
+    }
+    return lo;
+  };
+  if (need > 1.02 * seconds_left) return longest(i + 1, n);
+  if (s.kind == "step" && need < 0.90 * seconds_left) return longest(n, i + 4 * (n - i));
+  return n;
 }
 
 }  // namespace jsa
