@@ -234,18 +234,19 @@ TEST_CASE("budgeted_iterations: a run is shortened to what is left, lengthened o
   // Cheaper steps than planned, under the ramp: not lengthened (M would go back down).
   CHECK(jsa::budgeted_iterations(ramp, m, overhead, 100, n, decay, 1e-4, rest * 1e-3) == n);
   // At a fixed M (collections, --preset paper): lengthened to the longest run
-  // whose rest fits in 97% of what is left, at most four times the rest.
+  // whose rest fits in 92% of what is left, at most four times the rest.
   jsa::ScheduleOptions step;
   step.kind = "step";
   const double cost = jsa::scheduled_mean_cost(step, m, overhead, 100, n, n);  // per step
   const int64_t longer =
       jsa::budgeted_iterations(step, m, overhead, 100, n, decay, 1e-3, 2.0 * cost * 900 * 1e-3);
-  CHECK(longer == 100 + int64_t(0.97 * 2.0 * 900));  // twice the time: about twice the rest
+  CHECK(longer - 100 <= int64_t(0.92 * 2.0 * 900));  // twice the time: about twice the rest
+  CHECK(longer - 100 >= int64_t(0.92 * 2.0 * 900) - 1);
   CHECK(jsa::budgeted_iterations(step, m, overhead, 100, n, decay, 1e-3,
                                  100.0 * cost * 900 * 1e-3) == 100 + 4 * 900);
-  // Within 90-102% of what is left: unchanged (no back and forth).
-  CHECK(jsa::budgeted_iterations(step, m, overhead, 100, n, decay, 1e-3,
-                                 1.05 * cost * 900 * 1e-3) == n);
+  // Within 85-102% of what is left: unchanged (no back and forth).
+  CHECK(jsa::budgeted_iterations(step, m, overhead, 100, n, decay, 1e-3, 1.1 * cost * 900 * 1e-3) ==
+        n);
   // Past the first decay, not lengthened either.
   CHECK(jsa::budgeted_iterations(step, m, overhead, 800, n, decay, 1e-3, 100.0) == n);
   // Past the first decay the length stays (moving the decays would break the schedule) ...

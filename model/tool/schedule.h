@@ -95,9 +95,11 @@ inline double scheduled_cost_ratio(const ScheduleOptions& s, Index points, doubl
 //   - shorter when the rest does not fit (more than 102% of what is left):
 //     the longest length whose rest fits in 97% of it (at least i + 1);
 //   - longer when the steps have become cheaper than planned (the rest needs
-//     under 90% of what is left), at a fixed M only (`s.kind == "step"`; under
+//     under 85% of what is left), at a fixed M only (`s.kind == "step"`; under
 //     the ramp a longer run would take M back down a level): the longest length
-//     whose rest fits in 97% of what is left, at most four times the rest;
+//     whose rest fits in 92% of what is left, at most four times the rest (the
+//     margins keep a stretch's timing noise, about 10%, from shortening the run
+//     again at the next check);
 //   - else n.
 // The first estimate of a run is made from its first steps, and a machine
 // whose load drops afterwards (or steps that get cheaper as the model
@@ -111,19 +113,19 @@ inline int64_t budgeted_iterations(const ScheduleOptions& s, Index points, doubl
   };
   if (i >= first_decay) return n;
   const double need = cost_left(n) * seconds_per_cost;
-  // The longest length in [lo, hi] whose rest fits in 97% of what is left.
-  auto longest = [&](int64_t lo, int64_t hi) {
+  // The longest length in [lo, hi] whose rest fits in `share` of what is left.
+  auto longest = [&](int64_t lo, int64_t hi, double share) {
     while (lo < hi) {
       const int64_t mid = lo + (hi - lo + 1) / 2;
-      if (cost_left(mid) * seconds_per_cost <= 0.97 * seconds_left)
+      if (cost_left(mid) * seconds_per_cost <= share * seconds_left)
         lo = mid;
       else
         hi = mid - 1;
     }
     return lo;
   };
-  if (need > 1.02 * seconds_left) return longest(i + 1, n);
-  if (s.kind == "step" && need < 0.90 * seconds_left) return longest(n, i + 4 * (n - i));
+  if (need > 1.02 * seconds_left) return longest(i + 1, n, 0.97);
+  if (s.kind == "step" && need < 0.85 * seconds_left) return longest(n, i + 4 * (n - i), 0.92);
   return n;
 }
 
