@@ -85,6 +85,7 @@ auto with_flag_names(F&& f) {
       {"weights.repulsion", "--w-rep"},
       {"weights.code", "--w-code"},
       {"weights.metric", "--w-metric"},
+      {"metric_end", "--w-metric-end"},
       {"repulsion_tolerance", "--repulsion-tolerance"},
       {"wrap_steps", "--wrap"},
       {"reseed_every", "--reseed"},
@@ -649,6 +650,11 @@ void add_fit(CLI::App& app) {
                 "0's at the same domain points (beyond the paper; 0: off; docs/collections.md)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber)
+      ->check(kFinite);
+  c->add_option("--w-metric-end", o.metric_end,
+                "Collections: lambda_metric moves geometrically from --w-metric at the first "
+                "joint step to this at the first learning-rate decay (-1: constant)")
+      ->capture_default_str()
       ->check(kFinite);
   c->add_option("-o,--out", a->out_dir, "Output directory (created if needed)");
   c->add_option("--resume", a->resume,

@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
 # Installs exactly what jsatlas needs from Debian 12 packages. Idempotent.
 set -euo pipefail
+# libjs-three: `jsatlas view` inlines three.js into its pages (a runtime need,
+# and its tests run in the README's test command; chromium, for the browser
+# test only, is in scripts/install-view-deps.sh).
 pkgs=(cmake g++ make pkg-config libeigen3-dev libnanoflann-dev libtinyobjloader-dev catch2
-      libcli11-dev nlohmann-json3-dev libstb-dev)
+      libcli11-dev nlohmann-json3-dev libstb-dev libjs-three)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # What `jsatlas view` and its browser test need, beyond scripts/install-deps.sh:
-#   libjs-three  three.js (three.min.js, OrbitControls.js), inlined into every page;
+#   libjs-three  three.js (three.min.js, OrbitControls.js), inlined into every page
+#                (also in scripts/install-deps.sh, since `jsatlas view` needs it);
 #   chromium     headless browser of test/browser_view_test.cpp (skipped without it).
 # Neither is needed to build jsatlas. Called by .ci/run before the tests. Idempotent.
 set -euo pipefail

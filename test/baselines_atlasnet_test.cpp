@@ -239,9 +239,29 @@ TEST_CASE("keypoint_error: a map that carries each shape exactly onto another sc
   const KeypointError e = keypoint_error(identity, meshes, frames, keypoints);
   CHECK(e.pairs == 2);
   CHECK(e.mean < 1e-12);
+  CHECK(e.self_mean < 1e-12);
   // A map that always answers the unit frame's origin is off by |q_gt|, about 1 on the sphere.
   const CorrespondenceMap centre = [](int, int, const Block<double>& p, const Block<double>&) {
     return Block<double>(Block<double>::Zero(p.rows(), 3));
   };
-  CHECK(keypoint_error(centre, meshes, frames, keypoints).mean == Approx(1.0).margin(0.05));
+  const KeypointError c = keypoint_error(centre, meshes, frames, keypoints);
+  CHECK(c.mean == Approx(1.0).margin(0.05));
+  // Per keypoint: its distance from the centre in the unit frame, the same in both pairs.
+  const Block<double> unit = frames[0].to_unit(a.vertices);
+  REQUIRE(c.keypoint_mean.size() == 3);
+  for (size_t m = 0; m < 3; ++m)
+    CHECK(c.keypoint_mean[m] == Approx(unit.row(keypoints[0][m]).norm()).epsilon(1e-9));
+  // The self-maps (the diagonal) are off by the same distances, and kept out of the mean.
+  double self = 0;
+  for (size_t m = 0; m < 3; ++m) self += unit.row(keypoints[0][m]).norm() / 3;
+  CHECK(c.self_mean == Approx(self).epsilon(1e-9));
+  CHECK(c.pair_mean[1][1] == Approx(self).epsilon(1e-9));
+  // A map that is exact between shapes but not on a shape itself: only the self-map sees it.
+  const CorrespondenceMap off_self = [](int from, int to, const Block<double>& p,
+                                        const Block<double>&) {
+    return Block<double>(from == to ? Block<double>(p.array() + 0.1) : p);
+  };
+  const KeypointError s = keypoint_error(off_self, meshes, frames, keypoints);
+  CHECK(s.mean < 1e-12);
+  CHECK(s.self_mean == Approx(0.1 * std::sqrt(3.0)).epsilon(1e-9));
 }

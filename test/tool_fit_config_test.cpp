@@ -134,6 +134,20 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   REQUIRE(at != std::string::npos);
   before_split.erase(at, key.size());
   CHECK(!jsa::fit_options_from_json(before_split, "old").parallel_shapes);
+  // lambda_metric's end value (a later addition): kept, absent = constant, and
+  // a non-finite one refused.
+  jsa::FitOptions m;
+  m.metric_end = 0.1;
+  CHECK(jsa::fit_options_from_json(jsa::fit_options_to_json(m), "x").metric_end == 0.1);
+  std::string before_end = jsa::fit_options_to_json(m, -1);
+  const std::string end_key = ",\"metric_end\":0.1";
+  const auto end_at = before_end.find(end_key);
+  REQUIRE(end_at != std::string::npos);
+  before_end.erase(end_at, end_key.size());
+  CHECK(jsa::fit_options_from_json(before_end, "old").metric_end == -1);
+  std::string huge = jsa::fit_options_to_json(m, -1);
+  huge.replace(huge.find(end_key), end_key.size(), ",\"metric_end\":1e999");
+  CHECK_THROWS(jsa::fit_options_from_json(huge, "big"));
 }
 
 TEST_CASE("fit config: malformed JSON is rejected naming the source and the field",

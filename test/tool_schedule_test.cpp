@@ -71,6 +71,18 @@ TEST_CASE("schedule: the warm-up rises linearly from lr/10", "[schedule]") {
   CHECK(jsa::scheduled_lr(s, 1e-3, {0.75}, 0.1, 800, 1000) == Approx(1e-4));
 }
 
+TEST_CASE("schedule: a weight moves geometrically to its end value, then stays", "[schedule]") {
+  // 1e-2 -> 1e-1 by iteration 750 of 1000: a decade in 750 steps.
+  CHECK(jsa::scheduled_weight(1e-2, 1e-1, 0.75, 0, 1000) == Approx(1e-2));
+  CHECK(jsa::scheduled_weight(1e-2, 1e-1, 0.75, 375, 1000) == Approx(std::sqrt(1e-3)));
+  CHECK(jsa::scheduled_weight(1e-2, 1e-1, 0.75, 750, 1000) == Approx(1e-1));
+  CHECK(jsa::scheduled_weight(1e-2, 1e-1, 0.75, 999, 1000) == Approx(1e-1));
+  // Down as well; linear when an end is 0; constant when end < 0.
+  CHECK(jsa::scheduled_weight(1e-1, 1e-3, 0.5, 250, 1000) == Approx(1e-2));
+  CHECK(jsa::scheduled_weight(1e-2, 0, 0.5, 250, 1000) == Approx(5e-3));
+  CHECK(jsa::scheduled_weight(1e-2, -1, 0.5, 250, 1000) == 1e-2);
+}
+
 TEST_CASE("schedule: stored in the run's settings, older runs read as step",
           "[schedule][fit_config]") {
   jsa::FitOptions o;

@@ -110,6 +110,7 @@ KeypointError keypoint_error(const CorrespondenceMap& map, const std::vector<Mes
   e.thresholds = thresholds;
   e.within.assign(thresholds.size(), 0.0);
   e.pair_mean.assign(n, std::vector<double>(n, 0.0));
+  e.keypoint_mean.assign(k, 0.0);
   double total = 0;
   for (size_t i = 0; i < n; ++i) {
     const Block<double> unit = frames[i].to_unit(meshes[i].vertices);
@@ -120,13 +121,20 @@ KeypointError keypoint_error(const CorrespondenceMap& map, const std::vector<Mes
       pn.row(Index(m)) = normals.row(keypoints[i][m]);
     }
     for (size_t j = 0; j < n; ++j) {
-      if (i == j) continue;
       const Block<double> q = map(int(i), int(j), p, pn);
       const Block<double> target = frames[j].to_unit(meshes[j].vertices);
+      if (i == j) {  // the self-map: what reconstruction and inversion alone cost
+        double self = 0;
+        for (size_t m = 0; m < k; ++m) self += (q.row(Index(m)) - unit.row(keypoints[i][m])).norm();
+        e.pair_mean[i][i] = self / double(k);
+        e.self_mean += e.pair_mean[i][i] / double(n);
+        continue;
+      }
       double pair = 0;
       for (size_t m = 0; m < k; ++m) {
         const double d = (q.row(Index(m)) - target.row(keypoints[j][m])).norm();
         pair += d;
+        e.keypoint_mean[m] += d;
         for (size_t t = 0; t < thresholds.size(); ++t)
           if (d <= thresholds[t]) e.within[t] += 1;
       }
@@ -140,6 +148,7 @@ KeypointError keypoint_error(const CorrespondenceMap& map, const std::vector<Mes
   if (count > 0) {
     e.mean = total / count;
     for (double& w : e.within) w /= count;
+    for (double& w : e.keypoint_mean) w /= double(e.pairs);
   }
   return e;
 }

@@ -37,7 +37,12 @@ struct KeypointError {
   std::vector<double> within;  // fraction of keypoints within each threshold
   std::vector<double> thresholds;
   Index pairs = 0, keypoints = 0;
-  std::vector<std::vector<double>> pair_mean;  // [I][J] mean error (0 on the diagonal)
+  // [I][J] mean error; on the diagonal the self-map's, I's keypoints carried
+  // to I itself, which no consistency between shapes can remove: phi_I's
+  // reconstruction at the keypoints and (chart rule) psi_I's inversion of it.
+  std::vector<std::vector<double>> pair_mean;
+  double self_mean = 0;               // the diagonal's mean (not in `mean`)
+  std::vector<double> keypoint_mean;  // [m] keypoint m's error, mean over the pairs
 };
 
 // Any model's correspondence map: points p_unit (N x 3, unit frame of shape

@@ -86,6 +86,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["align_poses"] = o.align_poses;
   j["template_share"] = o.template_share;
   j["chart_from"] = o.chart_from;
+  j["metric_end"] = o.metric_end;
   j["code_lr_scale"] = o.code_lr_scale;
   j["parallel_shapes"] = o.parallel_shapes;
   j["pool"] = o.pool;
@@ -189,6 +190,9 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
     throw InputError(what + ": code_lr_scale must be positive");
   o.parallel_shapes = false;  // later addition: runs before it took one shape at a time
   if (j.contains("parallel_shapes")) field(j, "", "parallel_shapes", o.parallel_shapes);
+  o.metric_end = -1;  // later addition: absent = a constant lambda_metric
+  if (j.contains("metric_end")) field(j, "", "metric_end", o.metric_end);
+  if (!std::isfinite(o.metric_end)) throw InputError(what + ": metric_end must be finite");
   o.chart_from = 0;
   if (j.contains("chart_from")) field(j, "", "chart_from", o.chart_from);
   if (!(o.chart_from >= 0 && o.chart_from <= 1))

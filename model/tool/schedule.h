@@ -59,6 +59,18 @@ inline double scheduled_lr(const ScheduleOptions& s, double lr, const std::vecto
   return r;
 }
 
+// A loss weight that moves over the run (collections' L_metric,
+// FitOptions::metric_end): `start` at iteration 0 to `end` at iteration
+// `until` * n, then `end`. Geometric when both are positive (a weight's scale
+// is what matters, and 1e-2 -> 1e-1 should spend as long near each decade),
+// linear otherwise; end < 0 keeps `start` throughout.
+inline double scheduled_weight(double start, double end, double until, int64_t i, int64_t n) {
+  if (end < 0 || n <= 0) return start;
+  const double f = std::min(1.0, double(i) / (std::max(1e-9, until) * double(n)));
+  if (start > 0 && end > 0) return start * std::pow(end / start, f);
+  return start + (end - start) * f;
+}
+
 // The mean cost of the steps [i0, i1) of a run of n, with a step's cost
 // modelled as overhead + M_i (in points).
 inline double scheduled_mean_cost(const ScheduleOptions& s, Index points, double overhead,

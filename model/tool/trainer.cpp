@@ -48,6 +48,7 @@ static void validate(const FitOptions& o) {
   require(o.template_steps >= -1, "template_steps must be >= -1");
   require(o.template_share >= 0 && o.template_share < 1, "template_share must be in [0, 1)");
   require(o.chart_from >= 0 && o.chart_from <= 1, "chart_from must be in [0, 1]");
+  require(std::isfinite(o.metric_end), "metric_end must be finite (< 0: lambda_metric constant)");
   require(o.code_lr_scale > 0 && std::isfinite(o.code_lr_scale),
           "code_lr_scale must be positive and finite");
   const ScheduleOptions& s = o.schedule;
@@ -331,6 +332,9 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
   }
   ObjectiveOptions objective{options_.weights, options_.components, options_.repulsion_tolerance};
   if (atlas_->shapes() > 1) objective.metric_reference = 0;  // L_metric against shape 0
+  objective.weights.metric = scheduled_weight(
+      options_.weights.metric, options_.metric_end,
+      options_.decay_at.empty() ? 1.0 : options_.decay_at.front(), counter, options_.iterations);
   // The staged objective (FitOptions::chart_from): phi and P alone at first.
   if (double(iteration_) < options_.chart_from * double(options_.iterations))
     objective.components.chart = false;
@@ -557,6 +561,7 @@ void Trainer::load_state(const TrainerState& st, const std::string& what) {
   size_t at = 0;
   auto get = [&](void* p, size_t n) {
     if (st.optimiser.size() - at < n) throw InputError(what + ": truncated optimiser state");
+    if (n == 0) return;  // an empty moment vector has no data() to copy into
     std::memcpy(p, st.optimiser.data() + at, n);
     at += n;
   };

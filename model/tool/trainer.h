@@ -102,6 +102,10 @@ struct FitOptions {
   // Collections: the latent codes' learning rate as a multiple of the networks'
   // (a per-group rate: the codes' Adam steps are scaled by it). 1: one rate.
   double code_lr_scale = 1;
+  // Collections: lambda_metric moves from weights.metric at the first joint
+  // step to this value at the first learning-rate decay (geometrically;
+  // model/tool/schedule.h, scheduled_weight), then stays. < 0: constant.
+  double metric_end = -1;
   // Share of the run's cost spent on the template (when template_steps < 0).
   // `jsatlas fit` starts collections with -1 and 0.3 (docs/collections.md).
   double template_share = 0;
