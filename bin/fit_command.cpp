@@ -656,6 +656,9 @@ void add_fit(CLI::App& app) {
                 "joint step to this at the first learning-rate decay (-1: constant)")
       ->capture_default_str()
       ->check(kFinite);
+  c->add_flag("--metric-conformal", o.metric_conformal,
+              "Collections: L_metric compares the shapes' metrics up to a scale per point "
+              "(conformal) instead of exactly (isometric)");
   c->add_option("-o,--out", a->out_dir, "Output directory (created if needed)");
   c->add_option("--resume", a->resume,
                 "Continue the run in DIR from its model.ckpt (settings come from the checkpoint)");

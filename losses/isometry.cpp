@@ -1,5 +1,7 @@
 #include "losses/isometry.h"
 
+#include <cmath>
+
 #include "engine/ops.h"
 
 namespace jsa {
@@ -22,6 +24,19 @@ Var metric_mismatch(Tape<T>& t, Var du_a, Var dv_a, Var du_b, Var dv_b) {
   return mean(t, per_point);
 }
 
+template <class T>
+Var conformal_metric_mismatch(Tape<T>& t, Var du_a, Var dv_a, Var du_b, Var dv_b) {
+  const T root2 = T(std::sqrt(2.0));
+  auto form = [&](Var du, Var dv) {  // g = (E, sqrt2 F, G) / |(E, sqrt2 F, G)|, N x 3
+    return row_normalize(t, concat_cols(t, {row_dot(t, du, du), scale(t, row_dot(t, du, dv), root2),
+                                            row_dot(t, dv, dv)}));
+  };
+  const Var d = sub(t, form(du_a, dv_a), form(du_b, dv_b));
+  return mean(t, row_dot(t, d, d));
+}
+
+template Var conformal_metric_mismatch<float>(Tape<float>&, Var, Var, Var, Var);
+template Var conformal_metric_mismatch<double>(Tape<double>&, Var, Var, Var, Var);
 template Var metric_mismatch<float>(Tape<float>&, Var, Var, Var, Var);
 template Var metric_mismatch<double>(Tape<double>&, Var, Var, Var, Var);
 template Var isometry_loss<float>(Tape<float>&, Var, Var);

@@ -24,4 +24,14 @@ Var isometry_loss(Tape<T>& t, Var du, Var dv);
 template <class T>
 Var metric_mismatch(Tape<T>& t, Var du_a, Var dv_a, Var du_b, Var dv_b);
 
+// L_metric's conformal variant (`--metric conformal`): the two forms compared
+// up to a scale at each point. With g = (E, sqrt2 F, G) (|g| is then the
+// Frobenius norm of J^T J),
+//   L_conf = (1/M) sum_m | g_a / |g_a| - g_b / |g_b| |^2,
+// which is 0 exactly where J_a^T J_a = c J_b^T J_b, c > 0: a conformal map
+// between the two shapes. Lengths may change from shape to shape (a larger
+// bear, a longer leg), angles and the shape of the stretch may not.
+template <class T>
+Var conformal_metric_mismatch(Tape<T>& t, Var du_a, Var dv_a, Var du_b, Var dv_b);
+
 }  // namespace jsa

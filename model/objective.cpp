@@ -93,7 +93,10 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
     // data-parallel step exact: a code's gradient stays on its shape's rank).
     const Var ref_code = t.constant(Block<T>(t.value(atlas.phi_code(t, o.metric_reference))));
     const SurfacePoints ref = atlas.phi.evaluate(t, p, x_p, true, ref_code);
-    const Var metric = metric_mismatch(t, first_m(all.du), first_m(all.dv), ref.du, ref.dv);
+    const Var metric =
+        o.metric_conformal
+            ? conformal_metric_mismatch(t, first_m(all.du), first_m(all.dv), ref.du, ref.dv)
+            : metric_mismatch(t, first_m(all.du), first_m(all.dv), ref.du, ref.dv);
     weighted.push_back({w.metric, metric});
   }
   if (c.repulsion) {

@@ -48,6 +48,8 @@ struct ObjectiveOptions {
   // Collections: the shape whose metric every other shape's is compared with
   // by L_metric at the same domain points (-1: none).
   int metric_reference = -1;
+  // L_metric compares the forms up to a scale per point (conformal_metric_mismatch).
+  bool metric_conformal = false;
 };
 
 // Builds L_single of shape `shape` (0 for a single shape) on the tape and returns

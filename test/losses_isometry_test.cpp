@@ -110,3 +110,59 @@ TEST_CASE("metric_mismatch gradient passes the finite-difference check", "[isome
   INFO(r.report);
   CHECK(r.ok);
 }
+
+TEST_CASE("conformal_metric_mismatch: 0 up to a scale per point, the closed form otherwise",
+          "[isometry]") {
+  // A rotated copy scaled by a different factor on every row: the forms are
+  // proportional row by row, so the conformal mismatch is 0 (the isometric one is not).
+  Rng rng(4);
+  const Index m = 30;
+  Block<double> du(m, 3), dv(m, 3);
+  for (Index i = 0; i < m; ++i)
+    for (int k = 0; k < 3; ++k) du(i, k) = rng.normal(), dv(i, k) = rng.normal();
+  const Eigen::Matrix3d r =
+      Eigen::AngleAxisd(0.4, Eigen::Vector3d(3, -1, 2).normalized()).toRotationMatrix();
+  Block<double> du_s = du * r, dv_s = dv * r;
+  for (Index i = 0; i < m; ++i) {
+    const double c = 0.5 + 0.1 * double(i);
+    du_s.row(i) *= c;
+    dv_s.row(i) *= c;
+  }
+  auto run = [](bool conformal, const Block<double>& a, const Block<double>& b,
+                const Block<double>& c, const Block<double>& d) {
+    Tape<double> t;
+    const Var v0 = t.constant(a), v1 = t.constant(b), v2 = t.constant(c), v3 = t.constant(d);
+    return t.scalar(conformal ? conformal_metric_mismatch(t, v0, v1, v2, v3)
+                              : metric_mismatch(t, v0, v1, v2, v3));
+  };
+  CHECK(std::abs(run(true, du, dv, du_s, dv_s)) < 1e-24);
+  CHECK(run(false, du, dv, du_s, dv_s) > 1e-2);
+  // One row, a stretch (2, 1) against the identity: g_a = (4, 0, 1)/sqrt17,
+  // g_b = (1, 0, 1)/sqrt2, |g_a - g_b|^2 = 2 - 2 (4 + 1) / sqrt(34).
+  Block<double> a1 = Block<double>::Zero(1, 3), a2 = Block<double>::Zero(1, 3);
+  Block<double> b1 = Block<double>::Zero(1, 3), b2 = Block<double>::Zero(1, 3);
+  a1(0, 0) = 2, a2(0, 1) = 1, b1(0, 0) = 1, b2(0, 1) = 1;
+  // (row_normalize adds eps = 1e-12 under its square root.)
+  CHECK(run(true, a1, a2, b1, b2) == Approx(2 - 10 / std::sqrt(34.0)).epsilon(1e-10));
+}
+
+TEST_CASE("conformal_metric_mismatch gradient passes the finite-difference check", "[isometry]") {
+  // All four Jacobian blocks, default tolerances (relative 1e-5, absolute 1e-8,
+  // step 1e-6 relative, double precision). Smooth away from J = 0, which random
+  // normal rows avoid.
+  Rng rng(5);
+  std::vector<Block<double>> in;
+  for (int k = 0; k < 4; ++k) {
+    Block<double> b(12, 3);
+    for (Index i = 0; i < b.rows(); ++i)
+      for (int c = 0; c < 3; ++c) b(i, c) = rng.normal();
+    in.push_back(b);
+  }
+  const GradCheckResult r = check_gradients(
+      [](Tape<double>& t, const std::vector<Var>& v) {
+        return conformal_metric_mismatch(t, v[0], v[1], v[2], v[3]);
+      },
+      in);
+  INFO(r.report);
+  CHECK(r.ok);
+}

@@ -148,6 +148,16 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   std::string huge = jsa::fit_options_to_json(m, -1);
   huge.replace(huge.find(end_key), end_key.size(), ",\"metric_end\":1e999");
   CHECK_THROWS(jsa::fit_options_from_json(huge, "big"));
+  // The conformal L_metric (a later addition): kept, absent = isometric.
+  jsa::FitOptions c;
+  c.metric_conformal = true;
+  CHECK(jsa::fit_options_from_json(jsa::fit_options_to_json(c), "x").metric_conformal);
+  std::string before_conf = jsa::fit_options_to_json(c, -1);
+  const std::string conf_key = ",\"metric_conformal\":true";
+  const auto conf_at = before_conf.find(conf_key);
+  REQUIRE(conf_at != std::string::npos);
+  before_conf.erase(conf_at, conf_key.size());
+  CHECK(!jsa::fit_options_from_json(before_conf, "old").metric_conformal);
 }
 
 TEST_CASE("fit config: malformed JSON is rejected naming the source and the field",

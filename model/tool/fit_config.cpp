@@ -87,6 +87,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["template_share"] = o.template_share;
   j["chart_from"] = o.chart_from;
   j["metric_end"] = o.metric_end;
+  j["metric_conformal"] = o.metric_conformal;
   j["code_lr_scale"] = o.code_lr_scale;
   j["parallel_shapes"] = o.parallel_shapes;
   j["pool"] = o.pool;
@@ -193,6 +194,8 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   o.metric_end = -1;  // later addition: absent = a constant lambda_metric
   if (j.contains("metric_end")) field(j, "", "metric_end", o.metric_end);
   if (!std::isfinite(o.metric_end)) throw InputError(what + ": metric_end must be finite");
+  o.metric_conformal = false;  // later addition: absent = the isometric L_metric
+  if (j.contains("metric_conformal")) field(j, "", "metric_conformal", o.metric_conformal);
   o.chart_from = 0;
   if (j.contains("chart_from")) field(j, "", "chart_from", o.chart_from);
   if (!(o.chart_from >= 0 && o.chart_from <= 1))

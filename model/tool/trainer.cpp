@@ -332,6 +332,7 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
   }
   ObjectiveOptions objective{options_.weights, options_.components, options_.repulsion_tolerance};
   if (atlas_->shapes() > 1) objective.metric_reference = 0;  // L_metric against shape 0
+  objective.metric_conformal = options_.metric_conformal;
   objective.weights.metric = scheduled_weight(
       options_.weights.metric, options_.metric_end,
       options_.decay_at.empty() ? 1.0 : options_.decay_at.front(), counter, options_.iterations);

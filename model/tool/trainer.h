@@ -106,6 +106,9 @@ struct FitOptions {
   // step to this value at the first learning-rate decay (geometrically;
   // model/tool/schedule.h, scheduled_weight), then stays. < 0: constant.
   double metric_end = -1;
+  // Collections: L_metric up to a scale per point (conformal, losses/isometry.h)
+  // instead of the forms themselves (isometric).
+  bool metric_conformal = false;
   // Share of the run's cost spent on the template (when template_steps < 0).
   // `jsatlas fit` starts collections with -1 and 0.3 (docs/collections.md).
   double template_share = 0;
