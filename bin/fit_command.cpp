@@ -91,6 +91,7 @@ auto with_flag_names(F&& f) {
       {"reseed_every", "--reseed"},
       {"template_steps", "--template-steps"},
       {"template_share", "--template-share"},
+      {"template_shape", "--template-shape"},
       {"chart_from", "--chart-from"},
       {"code_lr_scale", "--code-lr-scale"},
       {"schedule.kind", "--schedule"},
@@ -187,6 +188,7 @@ void run_fit(FitArgs& a, Team& team) {
     // automatic template start (-1) is turned off below, not refused.
     FitOptions asked = o;
     if (asked.template_steps < 0) asked.template_steps = 0;
+    if (asked.template_shape < 0) asked.template_shape = 0;
     with_flag_names([&] { Trainer::require_rank_support(asked, int(inputs.size()), team.size()); });
   }
   if (!a.texture.empty())
@@ -317,6 +319,22 @@ void run_fit(FitArgs& a, Team& team) {
       std::cerr << "fit: no template start with " << team.size()
                 << " MPI ranks (--template-steps 0)\n";
   }
+  // The template (FitOptions::template_shape): -1 asks for the medoid of the
+  // aligned pools (model/tool/shape_input.h). A data-parallel run has no
+  // template start and keeps shape 0 as L_metric's reference.
+  if (!resuming && o.template_shape < 0) {
+    o.template_shape = 0;
+    if (!many && inputs.size() > 1) {
+      const MedoidChoice m = medoid_shape(pools);
+      o.template_shape = m.shape;
+      if (!a.quiet) {
+        std::cerr << "fit: template shape " << m.shape << " (" << inputs[size_t(m.shape)]
+                  << "), the medoid; Chamfer sums to the others:";
+        for (double v : m.sums) std::fprintf(stderr, " %.4g", v);
+        std::cerr << "\n";
+      }
+    }
+  }
   Trainer trainer = make_trainer(o, pools, &team);
   LossLog log;
   if (resuming) {
@@ -434,9 +452,9 @@ void run_fit(FitArgs& a, Team& team) {
     const double seconds = std::chrono::duration<double>(clock::now() - t0).count();
     wrap_seconds += seconds;
     if (!a.quiet)
-      std::cerr << "fit: template start: shape 0 alone for " << o.template_steps << " steps ("
-                << format_duration(seconds) << ", L " << trainer.last().total
-                << "), its codes copied to every shape\n";
+      std::cerr << "fit: template start: shape " << o.template_shape << " alone for "
+                << o.template_steps << " steps (" << format_duration(seconds) << ", L "
+                << trainer.last().total << "), its codes copied to every shape\n";
   }
   if (a.inject_fault_at >= 0) trainer.inject_faults(a.inject_fault_at, 1);
   const auto start = clock::now();
@@ -629,6 +647,8 @@ void add_fit(CLI::App& app) {
   // run: measured on the SHREC ants and teddies (docs/collections.md).
   o.template_steps = -1;
   o.template_share = 0.3;
+  // ... of its medoid, the most typical shape (docs/collections.md, sixth round).
+  o.template_shape = -1;
   CLI::App* c = app.add_subcommand(
       "fit", "Learn the atlas of a shape: domain P, parametrization phi, chart psi");
   c->add_option("inputs", a->inputs,
@@ -828,6 +848,11 @@ void add_fit(CLI::App& app) {
                 "codes copied to every shape (-1: from --template-share)")
       ->capture_default_str()
       ->check(CLI::Range(int64_t(-1), int64_t(100000000)));
+  c->add_option("--template-shape", o.template_shape,
+                "Collections: the shape the template start fits and copies, and L_metric's "
+                "reference (-1: the medoid, the shape closest to all others)")
+      ->capture_default_str()
+      ->check(CLI::Range(-1, 1 << 20));
   c->add_option("--template-share", o.template_share,
                 "Collections, with --template-steps -1: share of the run's time (or cost) spent on "
                 "the template start")

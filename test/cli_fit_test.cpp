@@ -171,6 +171,12 @@ TEST_CASE("cli: a collection with a shape batch and a user texture writes the te
   INFO(r.output);
   REQUIRE(r.code == 0);
   CHECK(read_text(dir + "/config.json").find("\"batch_shapes\": 2") != std::string::npos);
+  // The template (-1 by default: the medoid) is saved as the shape chosen.
+  const std::string config = read_text(dir + "/config.json");
+  const auto at = config.find("\"template_shape\": ");
+  REQUIRE(at != std::string::npos);
+  const int chosen = std::stoi(config.substr(at + 18));
+  CHECK((chosen >= 0 && chosen < 3));
   CHECK(fs::exists(dir + "/texture_transfer.png"));
   CHECK(fs::exists(dir + "/collection.png"));
   const std::string stem = fs::path(texture).stem().string();
@@ -186,6 +192,11 @@ TEST_CASE("cli: a collection with a shape batch and a user texture writes the te
   CHECK(r.code == 1);
   CHECK(r.output.find("config.json: not a readable image") != std::string::npos);
   CHECK(!fs::exists(other + "/model.ckpt"));
+  // A template the collection does not have: one line naming the flag.
+  r = run("fit builtin:sphere builtin:torus -o " + other + " --iters 2 --template-shape 2" +
+          kSmall);
+  CHECK(r.code == 1);
+  CHECK(r.output.find("--template-shape") != std::string::npos);
   fs::remove(texture);
 }
 

@@ -9,6 +9,7 @@
 #include "engine/parallel.h"
 #include "model/tool/domain_mesh.h"
 #include "model/tool/loss_log.h"
+#include "model/tool/shape_input.h"
 #include "model/tool/trainer.h"
 #include "test/scratch.h"
 #include "test/sphere_pool.h"
@@ -309,6 +310,39 @@ TEST_CASE("trainer: the template start fits shape 0 alone, then every shape star
   CHECK(r.last().total == u.last().total);
 }
 
+TEST_CASE("trainer: another template shape is fitted alone and copied to every shape",
+          "[trainer]") {
+  FitOptions o = small_options();
+  o.iterations = 10;
+  o.template_steps = 20;
+  o.template_shape = 1;
+  o.threads = 1;
+  const std::vector<Block<double>> three = {sphere_pool(3000, 1), sphere_pool(3000, 2),
+                                            sphere_pool(3000, 3)};
+  Trainer t(o, three);
+  const std::vector<float> start1 = code_row(t, "codes.phi", 1);
+  t.train_template(20);
+  CHECK(code_row(t, "codes.phi", 1) != start1);
+  // The template saw shape 1's data and no other: another shape 0 leaves it
+  // exactly as it was, another shape 1 changes it.
+  Trainer other0(o, {sphere_pool(3000, 7), three[1], three[2]});
+  Trainer other1(o, {three[0], sphere_pool(3000, 7), three[2]});
+  other0.train_template(20);
+  other1.train_template(20);
+  CHECK(code_row(other0, "codes.phi", 1) == code_row(t, "codes.phi", 1));
+  CHECK(code_row(other1, "codes.phi", 1) != code_row(t, "codes.phi", 1));
+  t.finish_template();
+  for (int s : {0, 2}) {
+    CHECK(code_row(t, "codes.phi", s) == code_row(t, "codes.phi", 1));
+    CHECK(code_row(t, "codes.psi", s) == code_row(t, "codes.psi", 1));
+  }
+  // A shape the collection does not have is refused, naming the setting.
+  o.template_shape = 3;
+  CHECK_THROWS_WITH(Trainer(o, three), Catch::Contains("template_shape"));
+  o.template_shape = -1;
+  CHECK_THROWS_WITH(Trainer(o, three), Catch::Contains("template_shape"));
+}
+
 TEST_CASE("trainer: shapes split over threads give the serial step's gradient", "[trainer]") {
   // Three shapes over two threads: tapes of one and two shapes, L_rep, the
   // codes' prior and L_metric's reference all in the first; also with a batch
@@ -393,4 +427,26 @@ TEST_CASE("trainer: chart_from trains phi and P alone until that fraction of the
   }
   t.step();  // from iteration 5: the full method
   CHECK(t.last().chart > 0);
+}
+
+TEST_CASE("medoid_shape: the shape between the others is the template", "[trainer]") {
+  // Spheres of radius 1.0, 1.2 and 1.1: the middle one (index 2) is closest
+  // to both others, whatever the order; identical sets tie to the lowest index.
+  auto scaled = [](double r, uint64_t seed) {
+    Block<double> p = sphere_pool(2000, seed);
+    p.leftCols(3) *= r;
+    return p;
+  };
+  const std::vector<Block<double>> three = {scaled(1.0, 1), scaled(1.2, 2), scaled(1.1, 3)};
+  const jsa::MedoidChoice m = jsa::medoid_shape(three);
+  CHECK(m.shape == 2);
+  REQUIRE(m.sums.size() == 3);
+  CHECK(m.sums[2] < m.sums[0]);
+  CHECK(m.sums[2] < m.sums[1]);
+  // Sums are Chamfer distances (mean squared, both ways): about (0.1^2 + 0.1^2) x 2
+  // for the middle sphere against the two at +-0.1, plus the sampling floor.
+  CHECK(m.sums[2] == Approx(0.04).margin(0.01));
+  const std::vector<Block<double>> same = {scaled(1.0, 1), scaled(1.0, 1)};
+  CHECK(jsa::medoid_shape(same).shape == 0);
+  CHECK(jsa::medoid_shape({scaled(1.0, 1)}).shape == 0);
 }

@@ -83,6 +83,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["reseed_every"] = o.reseed_every;
   j["dense_surface"] = o.dense_surface;
   j["template_steps"] = o.template_steps;
+  j["template_shape"] = o.template_shape;
   j["align_poses"] = o.align_poses;
   j["template_share"] = o.template_share;
   j["chart_from"] = o.chart_from;
@@ -194,6 +195,8 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   o.metric_end = -1;  // later addition: absent = a constant lambda_metric
   if (j.contains("metric_end")) field(j, "", "metric_end", o.metric_end);
   if (!std::isfinite(o.metric_end)) throw InputError(what + ": metric_end must be finite");
+  o.template_shape = 0;  // later addition: absent = shape 0, what older runs used
+  if (j.contains("template_shape")) field(j, "", "template_shape", o.template_shape);
   o.metric_conformal = false;  // later addition: absent = the isometric L_metric
   if (j.contains("metric_conformal")) field(j, "", "metric_conformal", o.metric_conformal);
   o.chart_from = 0;

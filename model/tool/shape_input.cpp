@@ -1,6 +1,9 @@
 #include "model/tool/shape_input.h"
 
+#include <algorithm>
+
 #include "io/geometry/builtin_shapes.h"
+#include "io/geometry/nearest.h"
 #include "io/geometry/surface_sampling.h"
 #include "io/mesh_io.h"
 
@@ -42,6 +45,36 @@ std::vector<RigidAlignment> align_to_first(std::vector<RunInput>& inputs,
     set_rotation(inputs[i], out[i].rotation);
   }
   return out;
+}
+
+MedoidChoice medoid_shape(const std::vector<Block<double>>& pools, Index samples) {
+  const size_t n = pools.size();
+  MedoidChoice c;
+  c.sums.assign(n, 0.0);
+  if (n < 2) return c;
+  std::vector<Block<double>> points(n);
+  for (size_t i = 0; i < n; ++i) {
+    const Index rows = std::min<Index>(samples, pools[i].rows());
+    points[i] = pools[i].topLeftCorner(rows, 3);
+  }
+  // One direction of the Chamfer distance: mean squared distance from a to b.
+  auto one_way = [](const Block<double>& a, const Block<double>& b) {
+    std::vector<int> index;
+    std::vector<double> d2;
+    nearest(a, b, index, &d2);
+    double sum = 0;
+    for (double d : d2) sum += d;
+    return sum / double(d2.size());
+  };
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = i + 1; j < n; ++j) {
+      const double d = one_way(points[i], points[j]) + one_way(points[j], points[i]);
+      c.sums[i] += d;
+      c.sums[j] += d;
+    }
+  for (size_t i = 1; i < n; ++i)
+    if (c.sums[i] < c.sums[size_t(c.shape)]) c.shape = int(i);
+  return c;
 }
 
 }  // namespace jsa

@@ -31,4 +31,17 @@ void set_rotation(RunInput& input, const Eigen::Matrix3d& rotation);
 std::vector<RigidAlignment> align_to_first(std::vector<RunInput>& inputs,
                                            const RigidAlignOptions& options = {});
 
+// The template of a collection's template start (FitOptions::template_shape,
+// `--template-shape -1`): the medoid, the shape whose symmetric Chamfer
+// distance (mean squared, both ways, on the first `samples` rows of the pools,
+// in their aligned unit frames) to all the others sums least. Starting every
+// shape from the most typical one asks the least deformation of the others:
+// a template whose arms are folded must grow arms for every other bear
+// (docs/collections.md, sixth round). Ties go to the lowest index.
+struct MedoidChoice {
+  int shape = 0;
+  std::vector<double> sums;  // per shape: its Chamfer distances to the others, summed
+};
+MedoidChoice medoid_shape(const std::vector<Block<double>>& pools, Index samples = 3000);
+
 }  // namespace jsa

@@ -71,6 +71,8 @@ void Trainer::require_rank_support(const FitOptions& o, int shapes, int ranks) {
   // others wait, so a data-parallel run starts all shapes jointly.
   if (ranks > 1 && template_steps_for(o, o.iterations, shapes) > 0)
     throw InputError("template_steps is not supported with more than one MPI rank");
+  if (ranks > 1 && o.template_shape != 0)
+    throw InputError("template_shape other than 0 is not supported with more than one MPI rank");
 }
 
 Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools, Team* team)
@@ -78,6 +80,9 @@ Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools, T
   JSA_CHECK(!pools.empty(), "no shapes to fit");
   validate(o);
   const int n = int(pools.size());
+  if (o.template_shape < 0 || o.template_shape >= n)
+    throw InputError("template_shape must name one of the " + std::to_string(n) + " shapes (0.." +
+                     std::to_string(n - 1) + ")");
   const int ranks = team ? team->size() : 1;
   require_rank_support(o, n, ranks);
   std::tie(first_shape_, last_shape_) = jsa::shape_block(n, ranks, team ? team->rank() : 0);
@@ -266,7 +271,7 @@ void Trainer::train_template(int64_t steps, const std::function<bool()>& cancell
   // decays stay fractions of the joint iterations, so --iters means the same
   // with or without a template (and --minutes can size the two apart); and M
   // does not drop when the joint run starts.
-  const std::vector<int> template_batch{0};
+  const std::vector<int> template_batch{options_.template_shape};
   // A fault rewinds template_done_ to the last snapshot: the steps are redone,
   // so the template ends with `steps` good steps more, as a run's iterations do.
   const int64_t target = template_done_ + steps;
@@ -289,8 +294,8 @@ void Trainer::finish_template() {
   if (template_finished_) return;
   template_finished_ = true;
   if (template_done_ == 0 || !atlas_->has_codes()) return;
-  // Every shape starts as the template: f_i <- f_0 for phi and psi, and the same
-  // for Adam's moments of the codes, so the first joint steps are the template's.
+  // Every shape starts as the template t: f_i <- f_t for phi and psi, and the
+  // same for Adam's moments of the codes, so the first joint steps are the template's.
   for (const char* name : {"codes.phi", "codes.psi"}) {
     const int id = atlas_->params.find(name);
     JSA_CHECK(id >= 0, "the atlas has no " << name);
@@ -299,8 +304,10 @@ void Trainer::finish_template() {
          {&atlas_->params.values(), &adam_.first_moment(), &adam_.second_moment()}) {
       if (buffer->empty()) continue;
       float* block = buffer->data() + e.offset;  // rows x cols, row-major: one code per row
-      for (Index r = 1; r < e.rows; ++r)
-        for (Index c = 0; c < e.cols; ++c) block[r * e.cols + c] = block[c];
+      const Index t = options_.template_shape;
+      for (Index r = 0; r < e.rows; ++r)
+        if (r != t)
+          for (Index c = 0; c < e.cols; ++c) block[r * e.cols + c] = block[t * e.cols + c];
     }
   }
   take_snapshot(rng_.state());  // a fault in the joint run must not undo the copy
@@ -331,7 +338,7 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
       targets_[k].row(m) = pool.row(Index(rng.below(uint64_t(pool.rows()))));
   }
   ObjectiveOptions objective{options_.weights, options_.components, options_.repulsion_tolerance};
-  if (atlas_->shapes() > 1) objective.metric_reference = 0;  // L_metric against shape 0
+  if (atlas_->shapes() > 1) objective.metric_reference = options_.template_shape;  // L_metric's
   objective.metric_conformal = options_.metric_conformal;
   objective.weights.metric = scheduled_weight(
       options_.weights.metric, options_.metric_end,

@@ -92,6 +92,10 @@ struct FitOptions {
   // (the CLI times the steps under --minutes; otherwise share / (1 - share) *
   // iterations * N * the ramp's cost ratio, scheduled_cost_ratio).
   int64_t template_steps = 0;
+  // Collections: the shape the template start fits and copies, and L_metric's
+  // reference. `jsatlas fit --template-shape -1` picks the medoid
+  // (model/tool/shape_input.h) and stores its index here.
+  int template_shape = 0;
   // Collections: turn every shape into the pose of the first before fitting
   // (io/geometry/rigid_align.h, applied by the caller: model/tool/shape_input.h).
   bool align_poses = true;
@@ -137,6 +141,7 @@ inline void apply_paper_method(FitOptions& o) {
   o.weights.metric = 0;                   // not in the paper
   o.schedule.kind = "step";               // and at a fixed M from the first step
   o.template_steps = 0;                   // the paper trains all shapes jointly from the start
+  o.template_shape = 0;
   o.template_share = 0;
   o.align_poses = false;  // and takes the shapes in the poses given
 }
