@@ -83,6 +83,8 @@ case "$mode" in
     expect_error "2 MPI ranks for 1 shapes" 2 fit builtin:sphere -o too_many --iters 2 -q
     expect_error "--wrap is not supported with more than one MPI rank" 2 "${fit[@]}" --wrap 5 -o wrapped
     expect_error "--template-steps is not supported with more than one MPI rank" 2 fit --list \
-      shapes.txt --iters 2 --template-steps 5 -o templated -q ;;
+      shapes.txt --iters 2 --template-steps 5 -o templated -q
+    expect_error "--template-shape other than 0 is not supported with more than one MPI rank" 2 \
+      fit --list shapes.txt --iters 2 --template-steps 0 --template-shape 2 -o other_template -q ;;
   *) echo "run_tests.sh: unknown mode $mode"; exit 2 ;;
 esac
