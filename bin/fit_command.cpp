@@ -310,7 +310,7 @@ void run_fit(FitArgs& a, Team& team) {
                           [&](std::ostream& out) { out << r.dump(2) << "\n"; });
   }
 
-  // The template start trains shape 0 alone, which a data-parallel run cannot
+  // The template start trains one shape alone, which a data-parallel run cannot
   // share out: its automatic length (-1, the default for collections) is 0 on
   // more than one rank; an explicit length is refused by the trainer.
   if (many && o.template_steps < 0) {
@@ -410,7 +410,7 @@ void run_fit(FitArgs& a, Team& team) {
   const bool collection = inputs.size() > 1;
   if (!resuming && collection &&
       (o.template_steps > 0 || (o.template_steps < 0 && o.template_share > 0))) {
-    // The template start (FitOptions::template_steps): shape 0 alone, then its
+    // The template start (FitOptions::template_steps): the template alone, then its
     // codes copied to every shape. Under --minutes its length is the share of
     // the budget, timed on its own steps (a fifth of a joint step for N = 4).
     const auto t0 = clock::now();
@@ -843,9 +843,10 @@ void add_fit(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0))
       ->check(kFinite);
-  c->add_option("--template-steps", o.template_steps,
-                "Collections: steps fitting shape 0 alone before the joint training, then its "
-                "codes copied to every shape (-1: from --template-share)")
+  c->add_option(
+       "--template-steps", o.template_steps,
+       "Collections: steps fitting the template shape alone before the joint training, then its "
+       "codes copied to every shape (-1: from --template-share)")
       ->capture_default_str()
       ->check(CLI::Range(int64_t(-1), int64_t(100000000)));
   c->add_option("--template-shape", o.template_shape,

@@ -44,10 +44,22 @@ build_asan() {
   cmake --build build-asan -j "$jobs"
 }
 
+# Left out of the sanitizer run: long training loops whose code shorter tests
+# also run under the sanitizers, and what is not ours to check (2026-12-02,
+# ASan seconds on a 2-core machine, all tests 363 s at -j2):
+#   texture transfer of a 3-shape collection (79 s; the collection fit, the
+#     valid-UV pipeline and the texture outputs run in "fit writes every output"
+#     and the geometry room's tests), reseed_flipped_means on a flipped half
+#     (75 s; "moving flipped Gaussians is reported" runs the reseed),
+#     wrap_initialize (67 s; "the starting wrap is reported" runs the wrap),
+#     the examples (40 s; the library calls they make are tested), the
+#     find_package consumer (a CMake build) and the browser test (Chromium).
+asan_skip='(texture transfer|reseed_flipped_means: a flipped half|wrap_initialize: phi lands|^example_|^find_package_consumer$|^browser:)'
+
 test_asan() {
   # halt_on_error: the first report fails the test; leaks are reported too.
   ASAN_OPTIONS=detect_leaks=1:halt_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    ctest --test-dir build-asan --output-on-failure -j "$jobs"
+    ctest --test-dir build-asan --output-on-failure -j "$jobs" -E "$asan_skip"
 }
 
 build_fuzz() {
