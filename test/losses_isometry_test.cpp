@@ -89,12 +89,9 @@ TEST_CASE("metric_mismatch: 0 for isometric pairs, the closed form for a stretch
   CHECK(mismatch(a1, a2, b1, b2) == Approx((row0 + row1) / 2).epsilon(1e-14));
 }
 
-TEST_CASE("metric_mismatch gradient passes the finite-difference check", "[isometry]") {
-  // With respect to all four Jacobian blocks, default tolerances (relative
-  // 1e-5, absolute 1e-8, step 1e-6 relative, double precision). The loss is a
-  // polynomial in its inputs, so the central differences are exact up to
-  // rounding and the check has no kinks to avoid.
-  Rng rng(3);
+// Four 12 x 3 blocks of standard normal entries: (J_u, J_v) of two shapes.
+static std::vector<Block<double>> four_jacobian_blocks(uint64_t seed) {
+  Rng rng(seed);
   std::vector<Block<double>> in;
   for (int k = 0; k < 4; ++k) {
     Block<double> b(12, 3);
@@ -102,6 +99,15 @@ TEST_CASE("metric_mismatch gradient passes the finite-difference check", "[isome
       for (int c = 0; c < 3; ++c) b(i, c) = rng.normal();
     in.push_back(b);
   }
+  return in;
+}
+
+TEST_CASE("metric_mismatch gradient passes the finite-difference check", "[isometry]") {
+  // With respect to all four Jacobian blocks, default tolerances (relative
+  // 1e-5, absolute 1e-8, step 1e-6 relative, double precision). The loss is a
+  // polynomial in its inputs, so the central differences are exact up to
+  // rounding and the check has no kinks to avoid.
+  const std::vector<Block<double>> in = four_jacobian_blocks(3);
   const GradCheckResult r = check_gradients(
       [](Tape<double>& t, const std::vector<Var>& v) {
         return metric_mismatch(t, v[0], v[1], v[2], v[3]);
@@ -150,14 +156,7 @@ TEST_CASE("conformal_metric_mismatch gradient passes the finite-difference check
   // All four Jacobian blocks, default tolerances (relative 1e-5, absolute 1e-8,
   // step 1e-6 relative, double precision). Smooth away from J = 0, which random
   // normal rows avoid.
-  Rng rng(5);
-  std::vector<Block<double>> in;
-  for (int k = 0; k < 4; ++k) {
-    Block<double> b(12, 3);
-    for (Index i = 0; i < b.rows(); ++i)
-      for (int c = 0; c < 3; ++c) b(i, c) = rng.normal();
-    in.push_back(b);
-  }
+  const std::vector<Block<double>> in = four_jacobian_blocks(5);
   const GradCheckResult r = check_gradients(
       [](Tape<double>& t, const std::vector<Var>& v) {
         return conformal_metric_mismatch(t, v[0], v[1], v[2], v[3]);
