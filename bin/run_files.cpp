@@ -54,6 +54,8 @@ nlohmann::json stats_json(const ValidUvStats& s, bool packed) {
   j["charts"] = s.charts;
   j["charts_from_psi"] = s.from_psi;
   j["charts_repaired"] = s.repaired;
+  j["charts_lscm"] = s.lscm;
+  j["charts_inherited"] = s.inherited;
   j["charts_tutte"] = s.tutte;
   j["single_faces"] = s.single_faces;
   j["slim_reverted"] = s.slim_reverted;
@@ -65,6 +67,7 @@ nlohmann::json stats_json(const ValidUvStats& s, bool packed) {
   j["packing_efficiency"] = s.packing_efficiency;
   j["padding_texels"] = s.padding_texels;
   j["torn_edges_cut"] = s.cut.torn_edges;
+  j["slits_closed"] = s.cut.slits_closed;
   j["nonmanifold_edges"] = s.cut.nonmanifold_edges;
   j["inconsistent_edges"] = s.cut.inconsistent_edges;
   j["boundary_edges"] = s.cut.boundary_edges;
@@ -217,9 +220,11 @@ ChartWritten write_chart(Atlas<float>& atlas, const Normalization& normalization
       if (!o.quiet) std::cerr << "warning: chart: " << warning << "\n";
     char line[200];
     std::snprintf(line, sizeof line,
-                  "%lld charts (%lld from psi, %lld repaired, %lld Tutte); %.2f s",
+                  "%lld charts (%lld from psi, %lld repaired, %lld LSCM, %lld Tutte, %lld halves "
+                  "of a split); %.2f s",
                   (long long)v.stats.charts, (long long)v.stats.from_psi,
-                  (long long)v.stats.repaired, (long long)v.stats.tutte, v.stats.seconds);
+                  (long long)v.stats.repaired, (long long)v.stats.lscm, (long long)v.stats.tutte,
+                  (long long)v.stats.inherited, v.stats.seconds);
     summary = line;
   }
   const UvQuality q = measure_uv_quality(mesh.vertices, mesh.faces, w.vt, w.uv_faces, qo);

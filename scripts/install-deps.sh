@@ -4,8 +4,13 @@ set -euo pipefail
 # libjs-three: `jsatlas view` inlines three.js into its pages (a runtime need,
 # and its tests run in the README's test command; chromium, for the browser
 # test only, is in scripts/install-view-deps.sh).
+# libsuitesparse-dev: CHOLMOD's supernodal Cholesky for the UV solves, with
+# OpenBLAS (its OpenMP build) under it: 6-7x Eigen's SimplicialLDLT on a
+# 250k-vertex chart (io/geometry/sparse_spd.h). The build falls back to Eigen
+# without them (-DJSATLAS_CHOLMOD=OFF).
 pkgs=(cmake g++ make pkg-config libeigen3-dev libnanoflann-dev libtinyobjloader-dev catch2
-      libcli11-dev nlohmann-json3-dev libstb-dev libjs-three)
+      libcli11-dev nlohmann-json3-dev libstb-dev libjs-three libsuitesparse-dev
+      libopenblas0-openmp)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -7,7 +7,7 @@
 namespace jsa {
 
 Similarity2 fit_similarity(const Block<double>& from, const Block<double>& to,
-                           const std::vector<double>& w) {
+                           const std::vector<double>& w, double min_scale, double max_scale) {
   JSA_CHECK(from.rows() == to.rows() && from.cols() == 2 && to.cols() == 2,
             "fit_similarity: N x 2 and N x 2");
   const Index n = from.rows();
@@ -39,6 +39,9 @@ Similarity2 fit_similarity(const Block<double>& from, const Block<double>& to,
     s.scale = r / norm;
     s.rotation << dot / r, -cross / r, cross / r, dot / r;
   }
+  // Clamped, the scale no longer minimises the sum; the rotation and the
+  // centroids still do, for any fixed scale.
+  s.scale = std::min(std::max(s.scale, min_scale), max_scale);
   s.translation = ct - s.scale * cf * s.rotation.transpose();
   return s;
 }

@@ -237,6 +237,77 @@ int cut_along_paths(const ChartMesh& m, const Block<double>& positions,
   return paths;
 }
 
+// A torn edge with the same chart on both sides is a slit in that chart. Where
+// a slit ends inside the chart (its end vertex has no other boundary edge of
+// the chart) the vertex keeps its full 3D angle around it, so any near-
+// isometric flattening folds the two sides over each other there and the
+// chart's boundary crosses itself. Such an edge is glued back (its faces are
+// unusable under psi anyway, so the repair lays them out), and so on along the
+// slit until it ends on the chart's boundary or closes a loop. Returns the
+// number of edges glued.
+Index close_slit_ends(const Faces& faces, const std::vector<int>& face_chart,
+                      const std::vector<int>& torn_link, std::vector<int>& neighbour) {
+  const int F = int(faces.rows());
+  Index V = 0;
+  for (int f = 0; f < F; ++f)
+    for (int k = 0; k < 3; ++k) V = std::max<Index>(V, faces(f, k) + 1);
+  // The chart's boundary half-edges at each vertex (both ends of each).
+  std::vector<std::vector<int>> at(static_cast<size_t>(V));
+  for (int f = 0; f < F; ++f)
+    if (face_chart[size_t(f)] >= 0)
+      for (int k = 0; k < 3; ++k)
+        if (neighbour[size_t(3 * f + k)] < 0) {
+          at[size_t(faces(f, k))].push_back(3 * f + k);
+          at[size_t(faces(f, (k + 1) % 3))].push_back(3 * f + k);
+        }
+  auto slit_twin = [&](int h) {
+    const int t = torn_link[size_t(h)];
+    return t >= 0 && neighbour[size_t(h)] < 0 &&
+                   face_chart[size_t(t / 3)] == face_chart[size_t(h / 3)]
+               ? t
+               : -1;
+  };
+  // v ends a slit in the chart of half-edge h when the chart's boundary
+  // half-edges at v are exactly h and its twin.
+  auto tip_edge = [&](int v) {
+    for (int h : at[size_t(v)]) {
+      const int t = slit_twin(h);
+      if (t < 0) continue;
+      const int chart = face_chart[size_t(h / 3)];
+      int others = 0;
+      for (int g : at[size_t(v)])
+        if (g != h && g != t && face_chart[size_t(g / 3)] == chart) ++others;
+      if (others == 0) return h;
+    }
+    return -1;
+  };
+  std::vector<int> queue;
+  for (Index v = 0; v < V; ++v)
+    if (!at[size_t(v)].empty()) queue.push_back(int(v));
+  Index glued = 0;
+  while (!queue.empty()) {
+    const int v = queue.back();
+    queue.pop_back();
+    const int h = tip_edge(v);
+    if (h < 0) continue;
+    const int t = torn_link[size_t(h)];
+    neighbour[size_t(h)] = t;
+    neighbour[size_t(t)] = h;
+    ++glued;
+    for (int e : {h, t}) {
+      const int f = e / 3, k = e % 3;
+      for (int w : {faces(f, k), faces(f, (k + 1) % 3)}) {
+        auto& list = at[size_t(w)];
+        list.erase(std::remove(list.begin(), list.end(), e), list.end());
+      }
+    }
+    // The slit's other end may now end inside the chart.
+    queue.push_back(faces(h / 3, h % 3));
+    queue.push_back(faces(h / 3, (h % 3 + 1) % 3));
+  }
+  return glued;
+}
+
 }  // namespace
 
 CutResult cut_charts(const Block<double>& positions, const Faces& faces, const Block<double>& uv,
@@ -440,6 +511,7 @@ CutResult cut_charts(const Block<double>& positions, const Faces& faces, const B
       if (nb >= 0 && face_chart[size_t(nb / 3)] != face_chart[size_t(f)])
         neighbour[size_t(3 * f + k)] = -1;
     }
+  out.slits_closed = close_slit_ends(faces, face_chart, torn_link, neighbour);
 
   // Charts as meshes; split those that are not disks.
   const int initial = int(chart_sign.size());
@@ -541,7 +613,8 @@ CutResult cut_charts(const Block<double>& positions, const Faces& faces, const B
 
 namespace jsa {
 
-std::vector<ChartMesh> split_chart(const ChartMesh& m, const Block<double>* positions) {
+std::vector<ChartMesh> split_chart(const ChartMesh& m, const Block<double>* positions,
+                                   const Block<double>* uv) {
   const int n = int(m.faces.size());
   if (n < 2) return {};
   // Local adjacency: half-edges glued when the chart has the twin b -> a.
@@ -641,6 +714,11 @@ std::vector<ChartMesh> split_chart(const ChartMesh& m, const Block<double>* posi
       const int f = sub.faces[i];
       sub.usable[i] = m.usable[size_t(f)];
       sub.faces[i] = m.faces[size_t(f)];
+    }
+    if (uv) {
+      sub.inherited_uv.resize(Index(sub.vertex.size()), 2);
+      for (size_t v = 0; v < sub.vertex.size(); ++v)
+        sub.inherited_uv.row(Index(v)) = uv->row(sub.vertex[v]);
     }
     for (int& v : sub.vertex) v = m.vertex[size_t(v)];
     sub.orientation = m.orientation;

@@ -43,12 +43,16 @@ struct ChartMesh {
   std::vector<int> vertex;   // input vertex of each local vertex
   int orientation = 1;       // +1, or -1 when psi maps the chart's core mirrored
   std::vector<char> usable;  // per face: psi's UVs usable there
+  // Empty, or per local vertex: the UVs of the chart this one was split from
+  // (a locally injective map at the 3D scale), a start to try before psi's.
+  Block<double> inherited_uv;
 };
 
 struct CutResult {
   std::vector<ChartMesh> charts;
   std::vector<int> skipped_faces;  // degenerate faces (repeated index or zero 3D area): no chart
   Index torn_edges = 0;            // inner edges cut because psi tears across them
+  Index slits_closed = 0;          // torn edges glued back: they ended inside their chart
   Index nonmanifold_edges = 0;     // edges used by more than two faces
   Index inconsistent_edges = 0;    // edges whose two faces disagree on orientation
   Index boundary_edges = 0;        // edges of one face (holes, open borders)
@@ -91,7 +95,8 @@ namespace jsa {
 // chart has one face or a half is not a disk.
 // With the input's positions (V x 3, indexed by chart.vertex) the distances
 // are 3D lengths between face centroids (Dijkstra) instead of dual-graph steps.
-std::vector<ChartMesh> split_chart(const ChartMesh& chart,
-                                   const Block<double>* positions = nullptr);
+// With `uv` (per local vertex of the chart) each half inherits its part of it.
+std::vector<ChartMesh> split_chart(const ChartMesh& chart, const Block<double>* positions = nullptr,
+                                   const Block<double>* uv = nullptr);
 
 }  // namespace jsa

@@ -1,8 +1,10 @@
 // A valid starting UV map for one chart, as close to psi's as possible: psi's
 // UVs when they are injective on the chart; else psi's UVs kept on the usable
 // faces and the rest filled by least squares conformal maps (LSCM, Levy et al.
-// 2002) with those vertices fixed, the free region grown ring by ring until the
-// result is injective; else Tutte's embedding (always bijective on a disk).
+// 2002) with those vertices fixed, the free region grown (by rings and by
+// surface distance) until the result is injective; else the chart's own LSCM
+// with a free boundary when it is injective; else Tutte's embedding (always
+// bijective on a disk).
 #pragma once
 #include <vector>
 
@@ -10,7 +12,7 @@
 
 namespace jsa {
 
-enum class ChartStart { psi, repaired, tutte, failed };
+enum class ChartStart { psi, repaired, lscm, tutte, inherited, failed };
 const char* to_string(ChartStart s);
 
 struct ChartStartResult {

@@ -1,12 +1,12 @@
 #include "io/geometry/uv_slim.h"
 
-#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
 
 #include "engine/parallel.h"
+#include "io/geometry/sparse_spd.h"
 
 namespace jsa {
 namespace {
@@ -128,8 +128,8 @@ SlimReport slim_symmetric_dirichlet(const Block<double>& positions, const Faces&
           pos[size_t(36 * f + 6 * i + j)] = position(var(f, i), var(f, j));
   });
   for (Index v = 0; v < 2 * V; ++v) diag[size_t(v)] = position(v, v);
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
-  solver.analyzePattern(H);
+  SpdSolver solver(SpdSolver::Use::many);
+  solver.analyze(H);
 
   // A tiny proximal term pins the translation (D does not see it).
   const double lambda = 1e-8;
@@ -193,8 +193,7 @@ SlimReport slim_symmetric_dirichlet(const Block<double>& positions, const Faces&
       values[diag[size_t(v)]] += lambda;
       g(v) += lambda * (v < V ? uv(v, 0) : uv(v - V, 1));
     }
-    solver.factorize(H);
-    if (solver.info() != Eigen::Success) break;
+    if (!solver.factorize(H)) break;
     const Eigen::VectorXd x = solver.solve(g);
     if (!x.allFinite()) break;
     Block<double> d(V, 2);

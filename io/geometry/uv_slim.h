@@ -5,7 +5,7 @@
 // Sorkine-Hornung 2017, "Scalable Locally Injective Mappings"): the local step
 // takes each triangle's closest rotation and reweights it from the energy's
 // singular-value derivatives, the global step solves one sparse weighted
-// least-squares system (Eigen's SimplicialLDLT, pattern analysed once). The
+// least-squares system (sparse_spd.h: CHOLMOD or Eigen, pattern analysed once). The
 // step along the result is capped at 0.8 of the largest that keeps every
 // triangle's signed area positive (Smith & Schaefer 2015, Sec. 4: a quadratic in
 // the step per triangle), then halved until the energy decreases. Started from

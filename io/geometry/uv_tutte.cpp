@@ -1,7 +1,8 @@
 #include "io/geometry/uv_tutte.h"
 
-#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
 #include <cmath>
+#include <utility>
 
 #include "engine/check.h"
 #include "io/geometry/uv_cut.h"
@@ -40,37 +41,45 @@ Block<double> tutte_embedding(const Block<double>& positions, const Faces& local
   for (Index v = 0; v < V; ++v)
     if (!on_boundary[size_t(v)]) slot[size_t(v)] = inner++;
   if (inner == 0) return uv;
-  // Uniform weights: L x = b with L = degree on the diagonal, -1 per inner
-  // neighbour, b = sum of the boundary neighbours' positions. Each undirected
-  // edge once (an edge is shared by two faces inside the chart).
-  std::vector<std::pair<int, int>> edges;
-  for (Index f = 0; f < local.rows(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      const int a = local(f, k), b = local(f, (k + 1) % 3);
-      edges.push_back({std::min(a, b), std::max(a, b)});
-    }
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  // Mean value weights (Floater 2003): w_ij = (tan(a/2) + tan(b/2)) / |x_i - x_j|,
+  // a and b the angles at i of the two triangles on the edge ij. Positive, so
+  // the embedding stays bijective, and close to the harmonic map, which does
+  // not depend on the resolution: uniform weights squeeze the inside of a fine
+  // chart geometrically with its graph distance from the boundary.
+  // Row i of L x = b: sum_j w_ij (x_i - x_j) = 0, boundary neighbours moved to b.
   std::vector<Eigen::Triplet<double>> trip;
   Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(inner, 2);
-  std::vector<double> degree(size_t(inner), 0);
-  for (const auto& [a, b] : edges) {
-    const int sa = slot[size_t(a)], sb = slot[size_t(b)];
-    if (sa >= 0) degree[size_t(sa)] += 1;
-    if (sb >= 0) degree[size_t(sb)] += 1;
-    if (sa >= 0 && sb >= 0) {
-      trip.push_back({sa, sb, -1.0});
-      trip.push_back({sb, sa, -1.0});
-    } else if (sa >= 0) {
-      rhs.row(sa) += uv.row(b);
-    } else if (sb >= 0) {
-      rhs.row(sb) += uv.row(a);
+  std::vector<double> diagonal(size_t(inner), 0);
+  for (Index f = 0; f < local.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int i = local(f, k), j = local(f, (k + 1) % 3), l = local(f, (k + 2) % 3);
+      const Eigen::Vector3d pi = positions.row(i).transpose(), pj = positions.row(j).transpose(),
+                            pl = positions.row(l).transpose();
+      const Eigen::Vector3d eij = pj - pi, eil = pl - pi;
+      const double lij = eij.norm(), lil = eil.norm();
+      if (!(lij > 0) || !(lil > 0)) continue;
+      // The angle at i, tan(angle / 2) = |e x f| / (|e||f| + e.f), stable near 0 and pi.
+      const double t = eij.cross(eil).norm() / (lij * lil + eij.dot(eil));
+      if (!std::isfinite(t)) continue;
+      // The angle at i lies between the edges ij and il: it adds to both weights.
+      for (const auto& [other, length] : {std::pair<int, double>{j, lij}, {l, lil}}) {
+        const int si = slot[size_t(i)];
+        if (si < 0) continue;
+        const double w = t / length;
+        diagonal[size_t(si)] += w;
+        const int so = slot[size_t(other)];
+        if (so >= 0)
+          trip.push_back({si, so, -w});
+        else
+          rhs.row(si) += w * uv.row(other);
+      }
     }
-  }
-  for (int i = 0; i < inner; ++i) trip.push_back({i, i, degree[size_t(i)]});
+  for (int i = 0; i < inner; ++i) trip.push_back({i, i, diagonal[size_t(i)]});
   Eigen::SparseMatrix<double> L(inner, inner);
   L.setFromTriplets(trip.begin(), trip.end());
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(L);
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> solver;
+  solver.analyzePattern(L);
+  solver.factorize(L);
   if (solver.info() != Eigen::Success)
     throw InputError("tutte: an inner vertex is not connected to the boundary");
   const Eigen::MatrixXd x = solver.solve(rhs);

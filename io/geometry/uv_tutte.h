@@ -1,6 +1,7 @@
 // Tutte's embedding (Tutte 1963, "How to draw a graph"; Floater 1997 for
 // triangulated disks): the boundary loop on a circle, spaced by 3D edge length,
-// and every inner vertex at the average of its neighbours. For a disk with a
+// and every inner vertex at a convex combination of its neighbours, here with
+// Floater's (2003) mean value weights. For a disk with a
 // strictly convex boundary the result is bijective: no triangle flips and
 // nothing overlaps. The bijective start for charts where psi is unusable.
 #pragma once

@@ -58,9 +58,16 @@ ChartOut single_face(const Block<double>& positions, const Faces& faces, const B
   return c;
 }
 
-std::vector<ChartOut> process_chart(const Block<double>& positions, const Faces& faces,
-                                    const Block<double>& psi_uv, const ChartMesh& m,
-                                    const ValidUvOptions& o, int depth = 0) {
+// What one chart came to: charts done, or its two halves to do again.
+struct ChartOutcome {
+  std::vector<ChartOut> done;
+  std::vector<ChartMesh> halves;
+};
+
+// psi_per_3d: psi's length per 3D length over the mesh's usable faces.
+ChartOutcome process_chart(const Block<double>& positions, const Faces& faces,
+                           const Block<double>& psi_uv, const ChartMesh& m, const ValidUvOptions& o,
+                           int depth, double psi_per_3d) {
   const SlimOptions& slim_options = o.slim;
   const Index Vc = Index(m.vertex.size());
   Block<double> pos(Vc, 3), psi(Vc, 2);
@@ -89,26 +96,29 @@ std::vector<ChartOut> process_chart(const Block<double>& positions, const Faces&
   const bool split_first =
       depth < o.max_split_depth && Index(m.faces.size()) >= o.split_before_tutte_faces &&
       std::count(m.usable.begin(), m.usable.end(), 1) > Index(m.faces.size()) / 2;
-  ChartStartResult start =
-      start_chart_uv(pos, m.local, scale * psi, m.usable, 3, /*tutte=*/!split_first);
-  // The chart cut in two and each half done again; empty if it cannot be cut.
-  auto halves_redone = [&]() {
-    std::vector<ChartOut> out;
-    const std::vector<ChartMesh> halves = split_chart(m, &positions);
-    if (halves.size() != 2) return out;
-    for (const ChartMesh& h : halves)
-      for (ChartOut& c : process_chart(positions, faces, psi_uv, h, o, depth + 1))
-        out.push_back(std::move(c));
+  ChartStartResult start;
+  if (m.inherited_uv.rows() == Vc && m.inherited_uv.allFinite() &&
+      chart_is_injective(m.local, m.inherited_uv)) {
+    start.uv = m.inherited_uv;  // its part of the parent's map (already at the 3D scale)
+    start.start = ChartStart::inherited;
+  } else {
+    start = start_chart_uv(pos, m.local, scale * psi, m.usable, 3, /*tutte=*/!split_first);
+  }
+  // The chart cut in two (each half is done again by the caller); empty if it cannot be cut.
+  auto halves = [&](const Block<double>* inherit = nullptr) {
+    ChartOutcome out;
+    out.halves = split_chart(m, &positions, inherit);
+    if (out.halves.size() != 2) out.halves.clear();
     return out;
   };
   if (start.start == ChartStart::failed && split_first) {
-    std::vector<ChartOut> out = halves_redone();
-    if (!out.empty()) return out;
+    ChartOutcome out = halves();
+    if (!out.halves.empty()) return out;
     start = start_chart_uv(pos, m.local, scale * psi, m.usable);
   }
   if (start.start == ChartStart::failed) {
-    std::vector<ChartOut> out;
-    for (int f : m.faces) out.push_back(single_face(positions, faces, psi_uv, f));
+    ChartOutcome out;
+    for (int f : m.faces) out.done.push_back(single_face(positions, faces, psi_uv, f));
     return out;
   }
   ChartOut c;
@@ -144,23 +154,50 @@ std::vector<ChartOut> process_chart(const Block<double>& positions, const Faces&
       for (int k = 0; k < 3; ++k) w[size_t(m.local(f, k))] += 1;
   if (std::all_of(w.begin(), w.end(), [](double x) { return x == 0; }))
     for (Index v = 0; v < Vc; ++v) w[size_t(v)] = psi.row(v).allFinite() ? 1.0 : 0.0;
-  c.uv3 = uv;
-  c.uv = fit_similarity(uv, psi, w).apply(uv);
-  if (m.orientation < 0) {
-    // Back to psi's place: the mirrored target's centroid is psi's mirrored.
-    double sw = 0, cx = 0;
-    for (Index v = 0; v < Vc; ++v)
-      if (w[size_t(v)] > 0) sw += w[size_t(v)], cx += w[size_t(v)] * psi(v, 0);
-    c.uv.col(0).array() -= 2 * cx / sw;
+  auto place = [&](const Block<double>& map) {
+    c.uv3 = map;
+    // The scale within 2x of psi's mean: where psi is unusable over most of
+    // the chart its UVs are folded or collapsed, and the fitted scale with them
+    // (a teddy's chart came out 5x too small).
+    c.uv = fit_similarity(map, psi, w, 0.5 * psi_per_3d, 2 * psi_per_3d).apply(map);
+    if (m.orientation < 0) {
+      // Back to psi's place: the mirrored target's centroid is psi's mirrored.
+      double sw = 0, cx = 0;
+      for (Index v = 0; v < Vc; ++v)
+        if (w[size_t(v)] > 0) sw += w[size_t(v)], cx += w[size_t(v)] * psi(v, 0);
+      c.uv.col(0).array() -= 2 * cx / sw;
+    }
+    c.area = uv_area(c.local, c.uv);
+  };
+  place(uv);
+  // Still far from an isometry: SLIM was stopped by the boundary (the chart's
+  // flattening overlaps itself) or the chart cannot flatten. SLIM again with
+  // the boundary free, from where it stopped: if that comes out injective the
+  // chart is done; else it is cut in two and each half starts from its part of
+  // that map (a half of an overlapping flattening is usually injective, and
+  // already near its optimum).
+  if (c.energy_end > o.split_energy && depth < o.max_split_depth && rep.time_capped &&
+      !c.reverted) {
+    // SLIM ran out of time, not out of descent (a very large chart): its
+    // injective map is the halves' start.
+    ChartOutcome out = halves(&c.uv3);
+    if (!out.halves.empty()) return out;
+  } else if (c.energy_end > o.split_energy && depth < o.max_split_depth) {
+    Block<double> free_uv = c.reverted ? start.uv : c.uv3;
+    const SlimReport again = slim_symmetric_dirichlet(pos, m.local, free_uv, slim_options);
+    c.iterations += again.iterations;
+    if (again.energy_end <= o.split_energy && chart_is_injective(m.local, free_uv)) {
+      c.reverted = false;
+      c.energy_end = again.energy_end;
+      place(free_uv);
+    } else {
+      ChartOutcome out = halves(again.energy_end < c.energy_end ? &free_uv : nullptr);
+      if (!out.halves.empty()) return out;
+    }
   }
-  c.area = uv_area(c.local, c.uv);
-  // Still far from an isometry (SLIM was stopped by the boundary, or the chart
-  // cannot flatten): cut it in two and do each half again.
-  if (c.energy_end > o.split_energy && depth < o.max_split_depth) {
-    std::vector<ChartOut> out = halves_redone();
-    if (!out.empty()) return out;
-  }
-  return {std::move(c)};
+  ChartOutcome out;
+  out.done.push_back(std::move(c));
+  return out;
 }
 
 }  // namespace
@@ -178,39 +215,92 @@ ValidUv make_valid_uv(const Block<double>& positions, const Faces& faces,
   CutResult cut = cut_charts(positions, faces, psi_uv, o.cut);
   report("cut", 1);
   ValidUv out;
-  const size_t n = cut.charts.size();
-  std::vector<std::vector<ChartOut>> results(n);
-  std::vector<size_t> order(n);
-  std::iota(order.begin(), order.end(), size_t(0));
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    return cut.charts[a].faces.size() > cut.charts[b].faces.size();
-  });
-  size_t large = 0;
-  while (large < n && Index(cut.charts[order[large]].faces.size()) >= o.large_chart_faces) ++large;
+  // Charts are done in rounds: every pending chart once (the large ones one at
+  // a time with OpenMP inside, the others in parallel with each other), and the
+  // halves of those split go to the next round. Each chart is named by its path
+  // (its index in the cut, then 0/1 per split), and the charts done are put in
+  // the order of their paths: the result does not depend on the scheduling.
+  struct Job {
+    ChartMesh mesh;
+    std::vector<int> path;
+  };
+  std::vector<Job> pending;
   double done = 0, total = 0;
-  for (const ChartMesh& m : cut.charts) total += double(m.faces.size());
+  for (size_t i = 0; i < cut.charts.size(); ++i) {
+    total += double(cut.charts[i].faces.size());
+    pending.push_back({std::move(cut.charts[i]), {int(i)}});
+  }
+  double usable3 = 0, usable2 = 0;
+  for (const Job& job : pending)
+    for (size_t i = 0; i < job.mesh.faces.size(); ++i) {
+      if (!job.mesh.usable[i]) continue;
+      const int f = job.mesh.faces[i];
+      const Eigen::Vector3d p0 = positions.row(faces(f, 0)).transpose(),
+                            p1 = positions.row(faces(f, 1)).transpose(),
+                            p2 = positions.row(faces(f, 2)).transpose();
+      usable3 += 0.5 * (p1 - p0).cross(p2 - p0).norm();
+      usable2 += 0.5 * std::abs(signed_area2(psi_uv.row(faces(f, 0)).transpose(),
+                                             psi_uv.row(faces(f, 1)).transpose(),
+                                             psi_uv.row(faces(f, 2)).transpose()));
+    }
+  const double psi_per_3d = usable3 > 0 && usable2 > 0 ? std::sqrt(usable2 / usable3) : 1.0;
+  std::vector<std::pair<std::vector<int>, ChartOut>> finished;
   report("charts", 0);
-  for (size_t i = 0; i < large; ++i) {
-    results[order[i]] = process_chart(positions, faces, psi_uv, cut.charts[order[i]], o);
-    done += double(cut.charts[order[i]].faces.size());
+  for (int depth = 0; !pending.empty(); ++depth) {
+    const size_t n = pending.size();
+    std::vector<ChartOutcome> outcomes(n);
+    std::vector<size_t> order(n);
+    std::iota(order.begin(), order.end(), size_t(0));
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+      return pending[a].mesh.faces.size() > pending[b].mesh.faces.size();
+    });
+    // One chart larger than all the others together runs alone with the
+    // threads inside it (over triangles; its sparse factorisations stay
+    // serial); otherwise the charts run in parallel with each other.
+    size_t large = 0;
+    Index rest = 0;
+    for (size_t i = 1; i < n; ++i) rest += Index(pending[order[i]].mesh.faces.size());
+    if (n > 0 && Index(pending[order[0]].mesh.faces.size()) >= o.large_chart_faces &&
+        Index(pending[order[0]].mesh.faces.size()) > rest)
+      large = 1;
+    for (size_t i = 0; i < large; ++i)
+      outcomes[order[i]] =
+          process_chart(positions, faces, psi_uv, pending[order[i]].mesh, o, depth, psi_per_3d);
+      // Each chart writes only its own slot.
+#pragma omp parallel for schedule(dynamic, 1)
+    for (long long i = (long long)large; i < (long long)n; ++i)
+      outcomes[order[size_t(i)]] = process_chart(
+          positions, faces, psi_uv, pending[order[size_t(i)]].mesh, o, depth, psi_per_3d);
+    std::vector<Job> next;
+    for (size_t i = 0; i < n; ++i) {
+      for (size_t k = 0; k < outcomes[i].done.size(); ++k) {
+        std::vector<int> path = pending[i].path;
+        path.push_back(int(k));
+        done += double(outcomes[i].done[k].faces.size());
+        finished.push_back({std::move(path), std::move(outcomes[i].done[k])});
+      }
+      for (size_t k = 0; k < outcomes[i].halves.size(); ++k) {
+        std::vector<int> path = pending[i].path;
+        path.push_back(int(k));
+        next.push_back({std::move(outcomes[i].halves[k]), std::move(path)});
+      }
+    }
+    pending.swap(next);
     report("charts", done / std::max(total, 1.0));
   }
-  // Each chart writes only its own slot: the result does not depend on scheduling.
-#pragma omp parallel for schedule(dynamic, 1)
-  for (long long i = (long long)large; i < (long long)n; ++i)
-    results[order[size_t(i)]] =
-        process_chart(positions, faces, psi_uv, cut.charts[order[size_t(i)]], o);
   report("charts", 1);
-
+  std::stable_sort(finished.begin(), finished.end(),
+                   [](const auto& x, const auto& y) { return x.first < y.first; });
   std::vector<ChartOut> charts;
-  for (auto& r : results)
-    for (auto& c : r) charts.push_back(std::move(c));
+  for (auto& f : finished) charts.push_back(std::move(f.second));
   ValidUvStats& s = out.stats;
   double area3 = 0;
   for (const ChartOut& c : charts) {
     ++s.charts;
     s.from_psi += !c.single && c.start == ChartStart::psi;
     s.repaired += !c.single && c.start == ChartStart::repaired;
+    s.lscm += !c.single && c.start == ChartStart::lscm;
+    s.inherited += !c.single && c.start == ChartStart::inherited;
     s.tutte += !c.single && c.start == ChartStart::tutte;
     s.single_faces += c.single;
     s.slim_reverted += c.reverted;

@@ -23,13 +23,14 @@ struct ValidUvOptions {
   // where psi put it (the shared domain's layout, for texture transfer across a
   // collection); charts are then injective but may overlap one another.
   bool pack_charts = true;
-  // Charts with at least this many faces run one at a time with OpenMP inside
-  // (over triangles); the smaller ones run in parallel with each other.
+  // A chart with at least this many faces, and more than all the others
+  // together, runs alone with OpenMP inside (over triangles); otherwise the
+  // charts run in parallel with each other.
   int large_chart_faces = 20000;
   // A chart whose symmetric Dirichlet energy (4 for an isometry) stays above
   // this after optimisation is cut in two and each half redone, at most
   // max_split_depth times: more charts, less distortion.
-  double split_energy = 6;
+  double split_energy = 4.5;
   int max_split_depth = 12;
   // A chart of at least this many faces, mostly usable, whose psi UVs cannot
   // be repaired into an injective start is split before Tutte is tried.
@@ -43,6 +44,8 @@ struct ValidUvStats {
   Index charts = 0;           // charts written (excluding skipped faces)
   Index from_psi = 0;         // charts started from psi's UVs as they were
   Index repaired = 0;         // charts started from psi's UVs with an LSCM repair
+  Index lscm = 0;             // charts started from their own free-boundary LSCM
+  Index inherited = 0;        // halves of a split chart started from their part of its map
   Index tutte = 0;            // charts started from Tutte's embedding
   Index single_faces = 0;     // faces laid out alone because their chart could not be embedded
   Index slim_reverted = 0;    // charts whose optimised map overlapped itself: the start kept
