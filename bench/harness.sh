@@ -4,6 +4,10 @@
 #  1. bench_iteration at the default (M = K = 2500, 5x128) and the paper
 #     (M = K = 10^4, 5x256) configurations: the step, its pieces, the SGEMM
 #     bound of the same shapes and the peak memory;
+#  1b. bench_sgemm_blas: the step's SGEMMs through Eigen and through each BLAS
+#     Debian ships that is installed (OpenBLAS, BLIS, reference; loaded at run
+#     time), with the machine's OPENBLAS_* environment as it is (what jsatlas
+#     would get) and unset (OpenBLAS's own kernel choice);
 #  2. bench_kernels: Chamfer 6D/2D, repulsion, exact assignment, each validated,
 #     with its inputs dumped for the SciPy peer;
 #  3. if /usr/bin/python3 imports torch: bench/peer_torch.py, self-test first,
@@ -42,7 +46,8 @@ section() { printf '\n==== %s\n' "$*"; }
 
 if [ "${NO_BUILD:-0}" != 1 ]; then
   section "build"
-  cmake --build "$b" -j"${JOBS:-$(nproc)}" --target bench_iteration bench_kernels bench_scaling_plot
+  cmake --build "$b" -j"${JOBS:-$(nproc)}" --target bench_iteration bench_kernels bench_scaling_plot \
+    bench_sgemm_blas
 fi
 
 # ---- 1. ours, per configuration
@@ -52,6 +57,17 @@ for c in $configs; do
   "$b/bench_iteration" --points "$m" --gaussians "$k" --width "$w" --depth "$d" \
     --threads "$threads" --runs "$runs" --csv "$out/iteration.csv" | tee "$out/iteration_$name.log"
 done
+
+# ---- 1b. the SGEMM choice: Eigen against the BLAS libraries installed
+blas_libs=()
+for lib in openblas-openmp/libblas.so.3 blis-openmp/libblas.so.3 blas/libblas.so.3; do
+  [ -e "/usr/lib/x86_64-linux-gnu/$lib" ] && blas_libs+=(--blas "/usr/lib/x86_64-linux-gnu/$lib")
+done
+section "bench_sgemm_blas, machine environment (OPENBLAS_CORETYPE=${OPENBLAS_CORETYPE:-unset})"
+"$b/bench_sgemm_blas" --threads "$threads" --runs "$runs" "${blas_libs[@]}" | tee "$out/sgemm_blas.log"
+section "bench_sgemm_blas, OPENBLAS_* unset"
+env -u OPENBLAS_CORETYPE -u OPENBLAS_L2_SIZE "$b/bench_sgemm_blas" --threads "$threads" \
+  --runs "$runs" "${blas_libs[@]}" | tee "$out/sgemm_blas_unset.log"
 
 # ---- 2. kernels, inputs dumped for the SciPy peer
 section "bench_kernels"
@@ -191,6 +207,17 @@ build_type="$(sed -n 's/^CMAKE_BUILD_TYPE:STRING=//p' "$b/CMakeCache.txt" 2>/dev
     cat "$out/peer_scipy.log"
     echo '```'
   fi
+  echo
+  echo "## The step's SGEMMs: Eigen against the installed BLAS libraries (GFLOP/s)"
+  echo
+  echo "Machine environment (OPENBLAS_CORETYPE=${OPENBLAS_CORETYPE:-unset}):"
+  echo '```'
+  cat "$out/sgemm_blas.log"
+  echo '```'
+  echo "OPENBLAS_CORETYPE and OPENBLAS_L2_SIZE unset:"
+  echo '```'
+  cat "$out/sgemm_blas_unset.log"
+  echo '```'
   if [ "${SCALING:-0}" = 1 ]; then
     echo
     echo "## Scaling (M = K, bench/scaling.sh)"
