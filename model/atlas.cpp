@@ -63,7 +63,10 @@ void evaluate_surface(Atlas<float>& atlas, const Block<double>& uv, Block<double
   if (du) du->resize(uv.rows(), 3);
   if (dv) dv->resize(uv.rows(), 3);
   Tape<float> t;
-  const Index batch = 8192;
+  // 2048 rows a batch: the tape of one batch (value and two tangent rows per
+  // point through every layer) is 32 MB at width 128; at 8192 it was 126 MB,
+  // on top of the trainer's, and set the default fit's peak memory.
+  const Index batch = 2048;
   for (Index b = 0; b < uv.rows(); b += batch) {
     const Index n = std::min(batch, uv.rows() - b);
     t.clear();
