@@ -223,8 +223,9 @@ TEST_CASE("schedule: out-of-range settings are refused naming the setting", "[sc
   CHECK_THROWS_WITH(jsa::Trainer(o, pool), "schedule.levels must be in [1, 1000]");
 }
 
-TEST_CASE("budgeted_iterations: a run is shortened to what is left, lengthened only at fixed M",
-          "[tool][schedule]") {
+TEST_CASE(
+    "budgeted_iterations: a run is shortened to what is left, lengthened while M keeps its level",
+    "[tool][schedule]") {
   jsa::ScheduleOptions ramp;  // the default: M from 625 to 2500 over 3/4 of the run
   const jsa::Index m = 2500;
   const double overhead = jsa::kStepOverheadPoints;
@@ -243,8 +244,22 @@ TEST_CASE("budgeted_iterations: a run is shortened to what is left, lengthened o
   const double more =
       jsa::scheduled_mean_cost(ramp, m, overhead, 100, k + 1, k + 1) * double(k + 1 - 100);
   CHECK(more * 2e-3 > 0.97 * rest * 1e-3);
-  // Cheaper steps than planned, under the ramp: not lengthened (M would go back down).
-  CHECK(jsa::budgeted_iterations(ramp, m, overhead, 100, n, decay, 1e-4, rest * 1e-3) == n);
+  // Cheaper steps than planned, under the ramp, on its first level (i / n = 0.1,
+  // the level ends at 0.1875): lengthened, up to four times the rest, M unchanged at i.
+  const int64_t first =
+      jsa::budgeted_iterations(ramp, m, overhead, 100, n, decay, 1e-4, rest * 1e-3);
+  CHECK(first > n);
+  CHECK(first <= 100 + 4 * (n - 100));
+  CHECK(jsa::scheduled_points(ramp, m, 100, first) == jsa::scheduled_points(ramp, m, 100, n));
+  // On the second level (i = 300 of 1000: 0.3 in [0.1875, 0.375)): lengthened
+  // only as far as keeps M at i on that level (n' <= 300 / 0.1875 = 1600).
+  const double rest300 = jsa::scheduled_mean_cost(ramp, m, overhead, 300, n, n) * double(n - 300);
+  const int64_t second =
+      jsa::budgeted_iterations(ramp, m, overhead, 300, n, decay, 1e-4, rest300 * 1e-3);
+  CHECK(second > n);
+  CHECK(second <= 1600);
+  CHECK(jsa::scheduled_points(ramp, m, 300, second) == jsa::scheduled_points(ramp, m, 300, n));
+  CHECK(jsa::scheduled_points(ramp, m, 300, second + 1) < jsa::scheduled_points(ramp, m, 300, n));
   // At a fixed M (collections, --preset paper): lengthened to the longest run
   // whose rest fits in 92% of what is left, at most four times the rest.
   jsa::ScheduleOptions step;

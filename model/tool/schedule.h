@@ -107,11 +107,13 @@ inline double scheduled_cost_ratio(const ScheduleOptions& s, Index points, doubl
 //   - shorter when the rest does not fit (more than 102% of what is left):
 //     the longest length whose rest fits in 97% of it (at least i + 1);
 //   - longer when the steps have become cheaper than planned (the rest needs
-//     under 85% of what is left), at a fixed M only (`s.kind == "step"`; under
-//     the ramp a longer run would take M back down a level): the longest length
-//     whose rest fits in 92% of what is left, at most four times the rest (the
-//     margins keep a stretch's timing noise, about 10%, from shortening the run
-//     again at the next check);
+//     under 85% of what is left): the longest length whose rest fits in 92% of
+//     what is left, at most four times the rest, and under the ramp no longer
+//     than keeps M at iteration i on its level (a longer run would take M back
+//     down; on the first level nothing does). The margins keep a stretch's
+//     timing noise, about 10%, from shortening the run again at the next check.
+//     (The ramp's first steps, the first estimate, are dearer per unit of cost
+//     than the later ones: without this a `--minutes 1` ramp run ended at 43-55 s.)
 //   - else n.
 // The first estimate of a run is made from its first steps, and a machine
 // whose load drops afterwards (or steps that get cheaper as the model
@@ -137,7 +139,24 @@ inline int64_t budgeted_iterations(const ScheduleOptions& s, Index points, doubl
     return lo;
   };
   if (need > 1.02 * seconds_left) return longest(i + 1, n, 0.97);
-  if (s.kind == "step" && need < 0.85 * seconds_left) return longest(n, i + 4 * (n - i), 0.92);
+  if (need < 0.85 * seconds_left) {
+    int64_t hi = i + 4 * (n - i);
+    if (s.kind != "step") {
+      // Under the ramp, no longer than keeps M at iteration i on its level
+      // (M at i falls as the run grows: i / n shrinks).
+      const Index now = scheduled_points(s, points, i, n);
+      int64_t lo = n;
+      while (lo < hi) {
+        const int64_t mid = lo + (hi - lo + 1) / 2;
+        if (scheduled_points(s, points, i, mid) == now)
+          lo = mid;
+        else
+          hi = mid - 1;
+      }
+      hi = lo;
+    }
+    if (hi > n) return longest(n, hi, 0.92);
+  }
   return n;
 }
 
