@@ -1,6 +1,6 @@
 // From psi's per-vertex UVs to a valid UV map of the same mesh: cut where psi
 // tears or folds (uv_cut), start each chart from psi's UVs or a repair of them
-// (uv_repair, Tutte as the last resort), lower its symmetric Dirichlet energy
+// (uv_repair: LSCM, then Tutte as the last resort), lower its symmetric Dirichlet energy
 // without inverting a triangle (uv_slim), align it back onto psi's layout by a
 // similarity (uv_align), and pack the charts into the unit square (uv_pack).
 // Every chart ends injective, counter-clockwise and a topological disk.
@@ -28,8 +28,10 @@ struct ValidUvOptions {
   // charts run in parallel with each other.
   int large_chart_faces = 20000;
   // A chart whose symmetric Dirichlet energy (4 for an isometry) stays above
-  // this after optimisation is cut in two and each half redone, at most
-  // max_split_depth times: more charts, less distortion.
+  // this after optimisation is optimised again with its boundary free; unless
+  // that map is injective and below this, the chart is cut in two and each
+  // half redone from its part of that map, at most max_split_depth times:
+  // more charts, less distortion.
   double split_energy = 4.5;
   int max_split_depth = 12;
   // A chart of at least this many faces, mostly usable, whose psi UVs cannot
