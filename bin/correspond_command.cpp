@@ -193,6 +193,7 @@ void run_eval_corr(const EvalCorrArgs& a) {
   j["pair_mean"] = e.pair_mean;  // the diagonal: the self-maps
   j["self_map_mean_x1e-2"] = 100 * e.self_mean;
   j["keypoint_mean"] = e.keypoint_mean;
+  j["keypoint_self_map"] = e.keypoint_self;
   j["keypoint_files"] = files;
   write_file_atomically(a.run + "/eval_corr.json",
                         [&](std::ostream& out) { out << j.dump(2) << "\n"; });

@@ -25,6 +25,7 @@
 #include "model/tool/checkpoint.h"
 #include "model/tool/fit_config.h"
 #include "model/tool/mpi/mpi_team.h"
+#include "model/tool/pose_by_fit.h"
 #include "model/tool/shape_input.h"
 
 namespace jsa::cli {
@@ -85,6 +86,7 @@ auto with_flag_names(F&& f) {
       {"weights.repulsion", "--w-rep"},
       {"weights.code", "--w-code"},
       {"weights.metric", "--w-metric"},
+      {"weights.coverage", "--w-coverage"},
       {"metric_end", "--w-metric-end"},
       {"repulsion_tolerance", "--repulsion-tolerance"},
       {"wrap_steps", "--wrap"},
@@ -112,6 +114,57 @@ auto with_flag_names(F&& f) {
 
 Trainer make_trainer(const FitOptions& o, const std::vector<Block<double>>& pools, Team* team) {
   return with_flag_names([&] { return Trainer(o, pools, team); });
+}
+
+// The pose step's near ties decided by fitting each (model/tool/pose_by_fit.h):
+// shapes with more than one pose within 1.25x of the lowest Chamfer are turned
+// into the pose whose short fit ends lowest. Returns each shape's fit losses
+// (no losses: no tie).
+std::vector<PoseFitChoice> choose_near_poses(const FitOptions& o, std::vector<RunInput>& shapes,
+                                             std::vector<RigidAlignment>& poses, bool quiet) {
+  std::vector<PoseFitChoice> fits(shapes.size());
+  std::vector<Block<double>> pools;
+  std::vector<std::vector<Eigen::Matrix3d>> candidates;
+  std::vector<size_t> which;
+  for (size_t i = 1; i < shapes.size(); ++i) {
+    if (poses[i].near_poses.size() < 2) continue;
+    RunInput input = shapes[i];
+    set_rotation(input, Eigen::Matrix3d::Identity());
+    pools.push_back(std::move(input.pool));
+    candidates.push_back(poses[i].near_poses);
+    which.push_back(i);
+  }
+  if (which.empty()) return fits;
+  PoseFitOptions p;
+  p.steps = o.pose_fit_steps;
+  p.scored = std::max<int64_t>(1, p.steps / 3);
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::vector<PoseFitChoice> c = choose_poses_by_fit(o, shapes[0].pool, pools, candidates, p);
+  for (size_t k = 0; k < which.size(); ++k) {
+    const size_t i = which[k];
+    const int chosen = c[k].chosen;
+    fits[i] = c[k];
+    poses[i].rotation = poses[i].near_poses[size_t(chosen)];
+    poses[i].chamfer = poses[i].near_chamfers[size_t(chosen)];
+    set_rotation(shapes[i], poses[i].rotation);
+    if (!quiet) {
+      std::cerr << "fit: shape " << i << " has " << candidates[k].size()
+                << " near-tied poses (Chamfer";
+      for (double v : poses[i].near_chamfers) std::fprintf(stderr, " %.4g", v);
+      std::cerr << "); short fits end at L";
+      for (double v : c[k].losses) std::fprintf(stderr, " %.4g", v);
+      std::cerr << ", L_6D";
+      for (double v : c[k].surfaces) std::fprintf(stderr, " %.4g", v);
+      std::cerr << ": pose " << chosen << " (" << rotation_angle_degrees(poses[i].rotation)
+                << " deg)\n";
+    }
+  }
+  if (!quiet)
+    std::cerr << "fit: near-tied poses decided by fitting in "
+              << format_duration(
+                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count())
+              << "\n";
+  return fits;
 }
 
 // The processes of this run: the MPI job when an MPI launcher started us, else one.
@@ -230,6 +283,8 @@ void run_fit(FitArgs& a, Team& team) {
   // rank 0 those of all (for rotations.json and the frames it saves); the check
   // below makes sure they agree.
   std::vector<RigidAlignment> poses(inputs.size());
+  std::vector<PoseFitChoice> pose_fits(inputs.size());
+  double pose_fit_seconds = 0;  // counted against --minutes, like the wrap and the template
   if (resuming) {
     for (size_t i = 0; i < inputs.size(); ++i) {
       set_rotation(shapes[i], resumed.normalizations[i].rotation);
@@ -239,6 +294,12 @@ void run_fit(FitArgs& a, Team& team) {
     const auto t0 = std::chrono::steady_clock::now();
     if (root) {
       poses = align_to_first(shapes);
+      if (o.pose_fit_steps > 0 && !many) {
+        const auto f0 = std::chrono::steady_clock::now();
+        pose_fits = choose_near_poses(o, shapes, poses, a.quiet);
+        pose_fit_seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - f0).count();
+      }
     } else {
       // align_to_first, for this rank's block only.
       for (int i = std::max(1, block_first); i < block_last; ++i) {
@@ -296,6 +357,22 @@ void run_fit(FitArgs& a, Team& team) {
         e["candidates"] = poses[i].candidates;
         e["input_pose_chamfer"] = poses[i].input_chamfer;
         e["kept_input_pose"] = poses[i].kept_input;
+        if (poses[i].near_poses.size() > 1) {
+          nlohmann::json near = nlohmann::json::array();
+          for (size_t k = 0; k < poses[i].near_poses.size(); ++k) {
+            nlohmann::json n = {
+                {"angle_degrees", rotation_angle_degrees(poses[i].near_poses[k])},
+                {"chamfer", poses[i].near_chamfers[k]},
+                {"degrees_from_chosen",
+                 rotation_angle_degrees(poses[i].near_poses[k].transpose() * poses[i].rotation)}};
+            if (k < pose_fits[i].losses.size()) {
+              n["fit_loss"] = pose_fits[i].losses[k];
+              n["fit_surface"] = pose_fits[i].surfaces[k];
+            }
+            near.push_back(n);
+          }
+          e["near_tied_poses"] = near;
+        }
       }
       r.push_back(e);
     }
@@ -392,11 +469,12 @@ void run_fit(FitArgs& a, Team& team) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   using clock = std::chrono::steady_clock;
-  double wrap_seconds = 0;
+  double wrap_seconds = pose_fit_seconds;
   if (!resuming && o.wrap_steps > 0) {
     const auto w0 = clock::now();
     const WrapReport w = trainer.wrap([] { return g_signal != 0; });
-    wrap_seconds = std::chrono::duration<double>(clock::now() - w0).count();
+    const double wrapping = std::chrono::duration<double>(clock::now() - w0).count();
+    wrap_seconds += wrapping;
     if (g_signal) {
       // Nothing trained yet: a checkpoint would hold a half-fitted wrap.
       std::cerr << "fit: interrupted while wrapping (before training); no checkpoint written\n";
@@ -404,7 +482,7 @@ void run_fit(FitArgs& a, Team& team) {
     }
     if (!a.quiet)
       std::cerr << "fit: phi and psi wrapped around the shape's ellipsoid (" << o.wrap_steps
-                << " steps, " << format_duration(wrap_seconds) << "; RMS error phi " << w.phi_error
+                << " steps, " << format_duration(wrapping) << "; RMS error phi " << w.phi_error
                 << ", psi " << w.psi_error << ")\n";
   }
   const bool collection = inputs.size() > 1;
@@ -665,6 +743,12 @@ void add_fit(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber)
       ->check(kFinite);
+  c->add_option("--w-coverage", o.weights.coverage,
+                "Weight of L_6D's coverage direction (every target near the reconstruction) "
+                "against its accuracy direction (1: the paper's Chamfer, Eq. 6)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber)
+      ->check(kFinite);
   c->add_option("--w-metric", o.weights.metric,
                 "Collections: lambda_metric on L_metric, each shape's metric J^T J against shape "
                 "0's at the same domain points (beyond the paper; 0: off; docs/collections.md)")
@@ -814,6 +898,11 @@ void add_fit(CLI::App& app) {
                 "after the first layer")
       ->capture_default_str()
       ->check(CLI::Range(0, 1));
+  c->add_option("--deform-layers", o.atlas.deform_layers,
+                "Collections: phi_i(x) = phi(x) + D(phi(x), f_i), each shape a deformation of "
+                "one surface by an MLP D of this many hidden layers (0: phi(x, f_i), the paper's)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 64));
   c->add_option("--reseed", o.reseed_every,
                 "Every N steps before the first decay, move the Gaussians of back-facing flaps to "
                 "the surface's holes (0: never, as the paper; see model/heuristics/reseed.h)")
@@ -864,6 +953,12 @@ void add_fit(CLI::App& app) {
               "Collections: turn every shape into the pose of the first (principal axes, ICP, "
               "lowest Chamfer) before fitting; rotations.json lists them")
       ->capture_default_str();
+  c->add_option("--pose-fit", o.pose_fit_steps,
+                "Collections, with --align: a shape with several poses within 1.25x of the lowest "
+                "Chamfer (near-symmetric) takes the pose whose short fit of N joint steps ends "
+                "lowest (0: the lowest Chamfer)")
+      ->capture_default_str()
+      ->check(CLI::Range(int64_t(0), int64_t(1) << 20));
   c->add_option("--batch-shapes", o.batch_shapes,
                 "Collections: shapes per iteration, a seeded random subset (0: all); the loss is "
                 "scaled by N/B")

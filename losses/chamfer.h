@@ -28,8 +28,10 @@ struct ChamferMatches {
 
 // CD(x, y) as a 1 x 1 tape node, differentiable in x and y (either may be a
 // constant). If matches is given it is filled with the association.
+// coverage: the weight w of the second direction, 1/M sum_j |y_j - x_{b_j}|^2
+// (every target reached by some x_i); 1 is Eq. 6.
 template <class T>
-Var chamfer(Tape<T>& t, Var x, Var y, ChamferMatches<T>* matches = nullptr);
+Var chamfer(Tape<T>& t, Var x, Var y, ChamferMatches<T>* matches = nullptr, double coverage = 1);
 
 // The dense variant of L_6D: the x -> Y direction searches `surface`, a fixed
 // pool far larger than this step's M (all of the shape's samples, indexed once),
@@ -45,7 +47,7 @@ Var chamfer(Tape<T>& t, Var x, Var y, ChamferMatches<T>* matches = nullptr);
 // matches->x_to_y then indexes surface.points().
 template <class T>
 Var chamfer(Tape<T>& t, Var x, Var y, const NearestIndex<T>& surface,
-            ChamferMatches<T>* matches = nullptr);
+            ChamferMatches<T>* matches = nullptr, double coverage = 1);
 
 // The same value without a tape (evaluation). Sums accumulate in double.
 template <class T>

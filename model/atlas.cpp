@@ -11,9 +11,15 @@ Atlas<T>::Atlas(const AtlasOptions& o) : options_(o) {
   JSA_CHECK(o.shapes >= 1 && (o.shapes == 1 || o.code_size > 0), "bad collection size");
   const int d = o.shapes > 1 ? o.code_size : 0;
   domain = Domain<T>(params, DomainOptions{o.gaussians, o.gaussian_noise});
-  phi = Parametrization<T>(
-      params, MlpShape{2, 3, o.width, o.hidden_layers, d, o.code_layer, o.softplus_beta},
-      T(o.alpha));
+  JSA_CHECK(o.deform_layers >= 0, "deform_layers must be >= 0");
+  if (d > 0 && o.deform_layers > 0)
+    phi = Parametrization<T>(
+        params, MlpShape{2, 3, o.width, o.hidden_layers, 0, 0, o.softplus_beta}, T(o.alpha),
+        MlpShape{3, 3, o.width, o.deform_layers, d, o.code_layer, o.softplus_beta});
+  else
+    phi = Parametrization<T>(
+        params, MlpShape{2, 3, o.width, o.hidden_layers, d, o.code_layer, o.softplus_beta},
+        T(o.alpha));
   psi =
       Chart<T>(params, MlpShape{6, 2, o.width, o.hidden_layers, d, o.code_layer, o.softplus_beta});
   if (d > 0) {

@@ -22,6 +22,11 @@ struct AtlasOptions {
       0;  // where codes enter phi and psi: 0 the input (concatenation), 1 after the first layer
   double softplus_beta =
       0;  // activation of phi and psi: 0 ReLU (paper), > 0 softplus of that sharpness
+  // Collections (beyond the paper): > 0 makes phi_i a deformation of one shared
+  // surface, phi_i(x) = phi(x) + D(phi(x), f_phi,i), D an MLP of this many hidden
+  // layers taking the code; phi itself then takes none (model/parametrize.h).
+  // 0: the paper's phi(x, f_phi,i).
+  int deform_layers = 0;
 };
 
 template <class T>

@@ -46,6 +46,12 @@ void Mlp<T>::initialize(Parameters<T>& params, Rng& rng) const {
 }
 
 template <class T>
+void Mlp<T>::scale_output_layer(Parameters<T>& params, T factor) const {
+  params.value(weight_.back()) *= factor;
+  params.value(bias_.back()) *= factor;
+}
+
+template <class T>
 Var Mlp<T>::forward(Tape<T>& t, Parameters<T>& params, Var x, Index value_rows, Var code) const {
   const Index rows = t.rows(x);
   if (value_rows < 0) value_rows = rows;

@@ -49,6 +49,8 @@ class Mlp {
   Mlp(Parameters<T>& params, const std::string& name, const MlpShape& shape);
   // PyTorch's nn.Linear default, as the authors' code used: W, b ~ U(-1/sqrt(in), 1/sqrt(in)).
   void initialize(Parameters<T>& params, Rng& rng) const;
+  // Multiplies the output layer's weights and bias (a residual branch that starts small).
+  void scale_output_layer(Parameters<T>& params, T factor) const;
   // y = f(x) or f([x, code]). value_rows < 0: plain rows. value_rows = N: x is
   // [value; tangents...]. code: 1 x code_size (required iff code_size > 0).
   Var forward(Tape<T>& t, Parameters<T>& params, Var x, Index value_rows = -1, Var code = {}) const;

@@ -60,8 +60,9 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
   // With `dense`, phi6(x_P) finds its match in the whole pool (losses/chamfer.h).
   const Var generated = c.normals ? first_m(all.phi6) : first_m(all.points);
   const Var sampled = c.normals ? s6 : slice_cols(t, s6, 0, 3);
-  const Var surface =
-      dense ? chamfer(t, generated, sampled, *dense) : chamfer(t, generated, sampled);
+  ChamferMatches<T>* const no_matches = nullptr;
+  const Var surface = dense ? chamfer(t, generated, sampled, *dense, no_matches, w.coverage)
+                            : chamfer(t, generated, sampled, no_matches, w.coverage);
   weighted.push_back({w.surface, surface});
   out.surface = double(t.scalar(surface));
 

@@ -23,6 +23,9 @@ struct LossWeights {
   double repulsion = 1.0;  // l_rep, on L_rep (Eq. 11)
   double code = 1e-4;      // collections: weight of the mean squared norm of the latent codes
   double metric = 0;       // collections: on L_metric (beyond the paper; losses/isometry.h)
+  // Inside L_6D: the weight of its coverage direction (each target's distance
+  // to the nearest phi6(x_P)) against its accuracy direction; 1 is Eq. 6.
+  double coverage = 1.0;
 };
 
 // Which parts of the method are on. The default is Table 1 row 11, the full method.

@@ -9,13 +9,21 @@ template <class T>
 SurfacePoints Parametrization<T>::evaluate(Tape<T>& t, Parameters<T>& params, Var x,
                                            bool with_jacobian, Var code) const {
   SurfacePoints s;
+  // phi_i(x) = p + D(p, f_i), p = phi(x), when phi deforms one surface per shape.
+  auto deformed = [&](Var p, Index value_rows) {
+    return add(t, p, deform_.forward(t, params, p, value_rows, code));
+  };
+  const Var phi_code = deforms_ ? Var{} : code;
   if (!with_jacobian) {
-    s.points = mlp_.forward(t, params, x, -1, code);
+    s.points = mlp_.forward(t, params, x, -1, phi_code);
+    if (deforms_) s.points = deformed(s.points, -1);
     return s;
   }
   // [x; e_u; e_v] -> [phi(x); J_u; J_v]: one pass, 3M rows (Eq. 1).
   const Index m = t.rows(x);
-  Stacked y = unstack(t, mlp_.forward(t, params, stack_tangents(t, x), m, code));
+  Var y3 = mlp_.forward(t, params, stack_tangents(t, x), m, phi_code);
+  if (deforms_) y3 = deformed(y3, m);  // [p + D; (I + dD/dp) J_u; (I + dD/dp) J_v]
+  Stacked y = unstack(t, y3);
   s.points = y.value;
   s.du = y.du;
   s.dv = y.dv;

@@ -28,17 +28,40 @@ class Parametrization {
   Parametrization(Parameters<T>& params, const MlpShape& shape, T alpha,
                   const std::string& name = "phi")
       : mlp_(params, name, shape), alpha_(alpha) {}
-  void initialize(Parameters<T>& params, Rng& rng) const { mlp_.initialize(params, rng); }
+  // A collection's phi as deformations of one surface (AtlasOptions::deform_layers):
+  //   phi_i(x) = p + D(p, f_i),  p = phi(x),
+  // `shape` phi's (no code), `deform` D's (in = out = 3, with the code). D is
+  // a function of the point in 3D, so the shapes share phi's layout of the
+  // domain and differ by a deformation that moves neighbours together; the
+  // tangents follow by the chain rule, J_i = (I + dD/dp) J, since D runs on
+  // the stacked rows [p; J_u; J_v] like any layer (engine/tangents.h).
+  Parametrization(Parameters<T>& params, const MlpShape& shape, T alpha, const MlpShape& deform)
+      : mlp_(params, "phi", shape),
+        deform_(params, "phi.deform", deform),
+        alpha_(alpha),
+        deforms_(true) {}
+  // MLPs as PyTorch's default; D's output layer then scaled by 1e-2, so every
+  // shape starts as phi's surface, nearly undeformed.
+  void initialize(Parameters<T>& params, Rng& rng) const {
+    mlp_.initialize(params, rng);
+    if (deforms_) {
+      deform_.initialize(params, rng);
+      deform_.scale_output_layer(params, T(1e-2));
+    }
+  }
   // x: M x 2 domain points. with_jacobian = false evaluates phi(x) alone.
   // code: the shape's latent code f_phi,i (1 x D) in a collection, else none.
   SurfacePoints evaluate(Tape<T>& t, Parameters<T>& params, Var x, bool with_jacobian,
                          Var code = {}) const;
   const Mlp<T>& mlp() const { return mlp_; }
   T alpha() const { return alpha_; }
+  bool deforms() const { return deforms_; }
 
  private:
   Mlp<T> mlp_;
+  Mlp<T> deform_;  // D (deforms_ only)
   T alpha_ = T(0.01);
+  bool deforms_ = false;
 };
 
 }  // namespace jsa

@@ -256,6 +256,9 @@ TEST_CASE("keypoint_error: a map that carries each shape exactly onto another sc
   for (size_t m = 0; m < 3; ++m) self += unit.row(keypoints[0][m]).norm() / 3;
   CHECK(c.self_mean == Approx(self).epsilon(1e-9));
   CHECK(c.pair_mean[1][1] == Approx(self).epsilon(1e-9));
+  REQUIRE(c.keypoint_self.size() == 3);
+  for (size_t m = 0; m < 3; ++m)  // both shapes are the same sphere: one distance per keypoint
+    CHECK(c.keypoint_self[m] == Approx(unit.row(keypoints[0][m]).norm()).epsilon(1e-9));
   // A map that is exact between shapes but not on a shape itself: only the self-map sees it.
   const CorrespondenceMap off_self = [](int from, int to, const Block<double>& p,
                                         const Block<double>&) {

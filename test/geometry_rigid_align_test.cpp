@@ -256,3 +256,44 @@ TEST_CASE("with normal_weight the normals tell a surface from its back", "[model
   CHECK_THROWS_WITH(jsa::rigid_align(moving.leftCols(3), fixed.leftCols(3), with_normals),
                     Catch::Contains("rows (points, unit normals)"));
 }
+
+TEST_CASE("poses within near_factor of the best are reported, one per pose",
+          "[model][rigid_align]") {
+  // The lumpy body has one pose: the others end at 2-3x its Chamfer.
+  const jsa::Block<double> fixed = lumpy(2000, 11);
+  const jsa::RigidAlignment one = jsa::rigid_align(lumpy(2000, 12), fixed);
+  CHECK(one.near_poses.size() == 1);
+  REQUIRE(!one.near_poses.empty());
+  CHECK(one.near_poses[0] == one.rotation);
+  CHECK(one.near_chamfers[0] == one.chamfer);
+
+  // Two bumps swapped by a half turn about z: that turn maps the body onto
+  // itself, so the input's pose and the half turn score alike and both are
+  // reported, more than 10 degrees apart, lowest Chamfer first.
+  auto two_bumps = [](jsa::Index n, uint64_t seed) {
+    jsa::Block<double> p = lumpy(n, seed);
+    for (jsa::Index i = 0; i < n; i += 2) {  // every other point: the half-turned copy
+      p(i, 0) = -p(i, 0);
+      p(i, 1) = -p(i, 1);
+    }
+    p.rowwise() -= p.colwise().mean();
+    return p;
+  };
+  const jsa::RigidAlignment two = jsa::rigid_align(two_bumps(3000, 13), two_bumps(3000, 14));
+  REQUIRE(two.near_poses.size() >= 2);
+  CHECK(two.near_chamfers[0] <= two.near_chamfers[1]);
+  CHECK(jsa::rotation_angle_degrees(two.near_poses[0].transpose() * two.near_poses[1]) > 10);
+  double to_identity = 180, to_half_turn = 180;
+  Eigen::Matrix3d half = Eigen::Matrix3d::Identity();
+  half(0, 0) = half(1, 1) = -1;
+  for (const Eigen::Matrix3d& r : two.near_poses) {
+    to_identity = std::min(to_identity, jsa::rotation_angle_degrees(r));
+    to_half_turn = std::min(to_half_turn, jsa::rotation_angle_degrees(r.transpose() * half));
+  }
+  CHECK(to_identity < 3);
+  CHECK(to_half_turn < 3);
+
+  jsa::RigidAlignOptions none;
+  none.near_factor = 0;
+  CHECK(jsa::rigid_align(two_bumps(3000, 13), two_bumps(3000, 14), none).near_poses.empty());
+}

@@ -229,6 +229,41 @@ TEST_CASE("dense chamfer gradient passes the finite-difference check", "[chamfer
   CHECK(r.ok);
 }
 
+TEST_CASE("chamfer's coverage weight scales the second direction, value and gradient",
+          "[chamfer]") {
+  // L_w = 1/N sum_i min_j |x_i - y_j|^2 + w/M sum_j min_i |y_j - x_i|^2, plain and dense.
+  const Block<double> x = random_block(40, 6, 850), y = random_block(30, 6, 851);
+  const Block<double> pool = random_block(500, 6, 852);
+  REQUIRE(smallest_match_gap(x, y) > 1e-4);
+  REQUIRE(smallest_match_gap(y, x) > 1e-4);
+  REQUIRE(smallest_match_gap(x, pool) > 1e-4);
+  const NearestIndex<double> surface(pool);
+  ChamferMatches<double>* const none = nullptr;
+  for (double w : {0.0, 2.5}) {
+    Tape<double> t;
+    CHECK(t.scalar(chamfer(t, t.constant(x), t.constant(y), none, w)) ==
+          Approx(one_way(x, y) + w * one_way(y, x)).epsilon(1e-12));
+    CHECK(t.scalar(chamfer(t, t.constant(x), t.constant(y), surface, none, w)) ==
+          Approx(one_way(x, pool) + w * one_way(y, x)).epsilon(1e-12));
+    const GradCheckResult plain = check_gradients(
+        [w, none](Tape<double>& t, const std::vector<Var>& v) {
+          return chamfer(t, v[0], v[1], none, w);
+        },
+        {x, y});
+    INFO("w = " << w << ": " << plain.report);
+    CHECK(plain.ok);
+    const GradCheckResult dense = check_gradients(
+        [&](Tape<double>& t, const std::vector<Var>& v) {
+          return chamfer(t, v[0], v[1], surface, none, w);
+        },
+        {x, y});
+    INFO("dense, w = " << w << ": " << dense.report);
+    CHECK(dense.ok);
+  }
+  Tape<double> t;
+  CHECK_THROWS(chamfer(t, t.constant(x), t.constant(y), none, -1.0));
+}
+
 TEST_CASE("chamfer timing at training-loop sizes", "[.bench][chamfer]") {
   // L_6D shape: 10^4 x 10^4 points in 6 columns, float, forward + backward:
   // xyz in a cube, the last three columns scaled to ~0.01 like the normals.

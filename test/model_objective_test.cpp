@@ -388,3 +388,75 @@ TEST_CASE("objective: L_metric is 0 for equal codes, and its gradient matches ce
   CHECK(checked > 20);  // shape 1's code (4) and every 3rd weight of two layers
   CHECK(worst <= 1.0);
 }
+
+TEST_CASE("objective: phi as a deformation per shape (deform_layers): gradients and Jacobians",
+          "[objective]") {
+  // phi_i(x) = p + D(p, f_i), p = phi(x): every parameter of phi, of D and the
+  // codes gets its gradient through the stacked rows, and the Jacobian those
+  // rows carry is the derivative of phi_i (central differences in u and v).
+  AtlasOptions ao = small_atlas_options();
+  ao.shapes = 2;
+  ao.code_size = 4;
+  ao.deform_layers = 2;
+  ao.softplus_beta = 10;  // smooth, so the differences in x cross no kink
+  Atlas<double> atlas(ao);
+  Rng init(5);
+  atlas.initialize(init);
+  REQUIRE(atlas.phi.deforms());
+  for (const char* name : {"codes.phi", "codes.psi"}) {
+    auto c = atlas.params.value(atlas.params.find(name));
+    for (Index i = 0; i < c.size(); ++i) c.data()[i] = 0.3 * std::sin(1.0 + 3.0 * double(i));
+  }
+  // D's output layer starts at 1e-2 of its default; grown here so that D matters.
+  for (const char* name : {"phi.deform.w2", "phi.deform.b2"})
+    atlas.params.value(atlas.params.find(name)) *= 100.0;
+  const std::vector<Block<double>> targets{random_targets(32, ao.alpha, 3),
+                                           random_targets(32, ao.alpha, 4)};
+  const Components c;
+  Tape<double> tape;
+  objective_value(atlas, targets, c, tape, true);
+  const std::vector<double> analytic = atlas.params.grads();
+  double worst = 0;
+  int checked = 0;
+  for (const char* name : {"codes.phi", "phi.deform.wf", "phi.deform.w0", "phi.deform.w2",
+                           "phi.deform.b1", "phi.w0", "phi.w2", "psi.wf", "domain.mu"}) {
+    const auto& e = atlas.params.entry(atlas.params.find(name));
+    worst = std::max(
+        worst, worst_central_difference(
+                   atlas, analytic, e.offset, e.offset + size_t(e.rows * e.cols), 3,
+                   [&]() { return objective_value(atlas, targets, c, tape, false); }, checked));
+  }
+  INFO(checked << " entries, worst error/tolerance " << worst);
+  CHECK(checked > 60);
+  CHECK(worst <= 1.0);
+
+  // The stacked tangents are phi_i's derivatives, shape by shape, and the two
+  // shapes differ (D takes the code).
+  Block<double> x(5, 2);
+  for (Index i = 0; i < x.size(); ++i) x.data()[i] = 0.1 + 0.15 * double(i % 7);
+  auto points = [&](const Block<double>& at, int shape, Block<double>* du, Block<double>* dv) {
+    Tape<double> t;
+    const SurfacePoints s = atlas.phi.evaluate(t, atlas.params, t.constant(at), du != nullptr,
+                                               atlas.phi_code(t, shape));
+    if (du) *du = t.value(s.du), *dv = t.value(s.dv);
+    return Block<double>(t.value(s.points));
+  };
+  double jacobian_error = 0;
+  for (int shape : {0, 1}) {
+    Block<double> du, dv;
+    points(x, shape, &du, &dv);
+    const double h = 1e-6;
+    for (int k = 0; k < 2; ++k) {
+      Block<double> xp = x, xm = x;
+      xp.col(k).array() += h;
+      xm.col(k).array() -= h;
+      const Block<double> numeric =
+          (points(xp, shape, nullptr, nullptr) - points(xm, shape, nullptr, nullptr)) / (2 * h);
+      jacobian_error =
+          std::max(jacobian_error, (numeric - (k == 0 ? du : dv)).cwiseAbs().maxCoeff());
+    }
+  }
+  CHECK(jacobian_error < 1e-6);
+  CHECK((points(x, 0, nullptr, nullptr) - points(x, 1, nullptr, nullptr)).cwiseAbs().maxCoeff() >
+        1e-3);
+}

@@ -158,6 +158,26 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   REQUIRE(conf_at != std::string::npos);
   before_conf.erase(conf_at, conf_key.size());
   CHECK(!jsa::fit_options_from_json(before_conf, "old").metric_conformal);
+  // Later additions read as off when absent, and are kept when set: the pose
+  // step's tie-break by fitting, and phi as a deformation per shape.
+  jsa::FitOptions d;
+  d.pose_fit_steps = 300;
+  d.atlas.deform_layers = 3;
+  const jsa::FitOptions read = jsa::fit_options_from_json(jsa::fit_options_to_json(d), "x");
+  CHECK(read.pose_fit_steps == 300);
+  CHECK(read.atlas.deform_layers == 3);
+  for (const std::string key : {",\"pose_fit_steps\":300", ",\"deform_layers\":3"}) {
+    std::string before = jsa::fit_options_to_json(d, -1);
+    const auto at = before.find(key);
+    REQUIRE(at != std::string::npos);
+    before.erase(at, key.size());
+    const jsa::FitOptions old = jsa::fit_options_from_json(before, "old");
+    CHECK(old.pose_fit_steps == (key.find("pose") != std::string::npos ? 0 : 300));
+    CHECK(old.atlas.deform_layers == (key.find("deform") != std::string::npos ? 0 : 3));
+  }
+  std::string negative = jsa::fit_options_to_json(d, -1);
+  negative.replace(negative.find(",\"deform_layers\":3"), 18, ",\"deform_layers\":-1");
+  CHECK_THROWS(jsa::fit_options_from_json(negative, "negative"));
 }
 
 TEST_CASE("fit config: malformed JSON is rejected naming the source and the field",

@@ -179,7 +179,7 @@ RigidAlignment rigid_align(const Block<double>& moving_all, const Block<double>&
   JSA_CHECK(moving_all.rows() >= 4 && fixed_all.rows() >= 4,
             "rigid_align needs at least 4 points per set");
   JSA_CHECK(o.samples >= 4 && o.icp_iterations >= 0 && o.final_iterations >= 0 && o.trim > 0 &&
-                o.trim <= 1 && o.normal_weight >= 0,
+                o.trim <= 1 && o.normal_weight >= 0 && o.near_factor >= 0,
             "bad rigid_align options");
   Block<double> moving = moving_all.topRows(std::min(o.samples, moving_all.rows()));
   Block<double> fixed = fixed_all.topRows(std::min(o.samples, fixed_all.rows()));
@@ -276,6 +276,26 @@ RigidAlignment rigid_align(const Block<double>& moving_all, const Block<double>&
   }
   out.rotation = icp(refined[best], o.final_iterations);
   out.chamfer = chamfer_and_update(sets, out.rotation, nullptr);
+  if (o.near_factor > 0) {
+    std::vector<size_t> order(scores.size());
+    for (size_t c = 0; c < order.size(); ++c) order[c] = c;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](size_t a, size_t b) { return scores[a] < scores[b]; });
+    std::vector<size_t> kept;
+    for (size_t c : order) {
+      if (scores[c] > o.near_factor * scores[order[0]]) break;
+      bool distinct = true;
+      for (size_t t : kept)
+        distinct = distinct && rotation_angle_degrees(refined[c].transpose() * refined[t]) > 10;
+      if (!distinct) continue;
+      kept.push_back(c);
+      // The winner's pose is represented by the winner, as refined above.
+      const bool winner = rotation_angle_degrees(refined[c].transpose() * refined[best]) <= 10;
+      const Eigen::Matrix3d r = winner ? out.rotation : icp(refined[c], o.final_iterations);
+      out.near_poses.push_back(r);
+      out.near_chamfers.push_back(winner ? out.chamfer : chamfer_and_update(sets, r, nullptr));
+    }
+  }
   out.candidates = int(candidates.size());
   out.runner_up = -1;
   for (size_t c = 0; c < scores.size(); ++c) {

@@ -24,6 +24,7 @@
 // report gives the runner-up's score so the caller can tell (`margin`).
 #pragma once
 #include <cstdint>
+#include <vector>
 
 #include "engine/block.h"
 
@@ -61,17 +62,28 @@ struct RigidAlignOptions {
   // (an ant's abdomen on another's head, end to end) scores worse than with
   // the points alone. 0: points only (N x 3 sets).
   double normal_weight = 0;
+  // The distinct poses (more than 10 degrees apart) whose Chamfer is within
+  // this factor of the lowest are reported in RigidAlignment::near_poses, for a
+  // caller that can tell them apart by other means (the fit itself:
+  // model/tool/pose_by_fit.h). 0: none reported.
+  double near_factor = 1.25;
 };
 
 struct RigidAlignment {
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // rows: moving x -> x * rotation ~ fixed
-  double chamfer = 0;            // symmetric Chamfer (mean squared distance, both ways) after ICP
-  double runner_up = 0;          // the best Chamfer of a candidate that ends > 10 degrees away
-  int candidates = 0;            // rotations tried (the input's pose and the axis candidates)
-  double input_chamfer = 0;      // ICP from the input's own pose
-  bool kept_input = false;       // the input's pose won by the keep_input rule
-  int tied = 1;                  // distinct poses within `tie` of the best Chamfer
-  bool tie_broken = false;       // the ball shares chose another pose than the lowest Chamfer
+  double chamfer = 0;        // symmetric Chamfer (mean squared distance, both ways) after ICP
+  double runner_up = 0;      // the best Chamfer of a candidate that ends > 10 degrees away
+  int candidates = 0;        // rotations tried (the input's pose and the axis candidates)
+  double input_chamfer = 0;  // ICP from the input's own pose
+  bool kept_input = false;   // the input's pose won by the keep_input rule
+  int tied = 1;              // distinct poses within `tie` of the best Chamfer
+  bool tie_broken = false;   // the ball shares chose another pose than the lowest Chamfer
+  // The poses within options.near_factor of the lowest Chamfer, one per pose
+  // (> 10 degrees apart), lowest Chamfer first, each refined by ICP like the
+  // winner (which is one of them unless a rule chose a pose outside): when there
+  // is more than one, the choice between them was close.
+  std::vector<Eigen::Matrix3d> near_poses;
+  std::vector<double> near_chamfers;
   double angle_degrees() const;  // of `rotation`
 };
 

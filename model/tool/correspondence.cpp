@@ -111,6 +111,7 @@ KeypointError keypoint_error(const CorrespondenceMap& map, const std::vector<Mes
   e.within.assign(thresholds.size(), 0.0);
   e.pair_mean.assign(n, std::vector<double>(n, 0.0));
   e.keypoint_mean.assign(k, 0.0);
+  e.keypoint_self.assign(k, 0.0);
   double total = 0;
   for (size_t i = 0; i < n; ++i) {
     const Block<double> unit = frames[i].to_unit(meshes[i].vertices);
@@ -125,7 +126,11 @@ KeypointError keypoint_error(const CorrespondenceMap& map, const std::vector<Mes
       const Block<double> target = frames[j].to_unit(meshes[j].vertices);
       if (i == j) {  // the self-map: what reconstruction and inversion alone cost
         double self = 0;
-        for (size_t m = 0; m < k; ++m) self += (q.row(Index(m)) - unit.row(keypoints[i][m])).norm();
+        for (size_t m = 0; m < k; ++m) {
+          const double d = (q.row(Index(m)) - unit.row(keypoints[i][m])).norm();
+          self += d;
+          e.keypoint_self[m] += d / double(n);
+        }
         e.pair_mean[i][i] = self / double(k);
         e.self_mean += e.pair_mean[i][i] / double(n);
         continue;

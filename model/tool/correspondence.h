@@ -43,6 +43,7 @@ struct KeypointError {
   std::vector<std::vector<double>> pair_mean;
   double self_mean = 0;               // the diagonal's mean (not in `mean`)
   std::vector<double> keypoint_mean;  // [m] keypoint m's error, mean over the pairs
+  std::vector<double> keypoint_self;  // [m] keypoint m's self-map error, mean over the shapes
 };
 
 // Any model's correspondence map: points p_unit (N x 3, unit frame of shape

@@ -49,7 +49,8 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
                 {"shapes", o.atlas.shapes},
                 {"code_size", o.atlas.code_size},
                 {"code_layer", o.atlas.code_layer},
-                {"softplus_beta", o.atlas.softplus_beta}};
+                {"softplus_beta", o.atlas.softplus_beta},
+                {"deform_layers", o.atlas.deform_layers}};
   j["weights"] = {{"surface_6d", o.weights.surface},
                   {"chart_2d", o.weights.chart},
                   {"cycle", o.weights.cycle},
@@ -57,6 +58,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
                   {"repulsion", o.weights.repulsion},
                   {"code", o.weights.code},
                   {"metric", o.weights.metric},
+                  {"coverage", o.weights.coverage},
                   {"convention", "mean over points (paper's 1/M factors folded in)"}};
   j["components"] = {{"normals", o.components.normals},
                      {"repulsion", o.components.repulsion},
@@ -85,6 +87,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["template_steps"] = o.template_steps;
   j["template_shape"] = o.template_shape;
   j["align_poses"] = o.align_poses;
+  j["pose_fit_steps"] = o.pose_fit_steps;
   j["template_share"] = o.template_share;
   j["chart_from"] = o.chart_from;
   j["metric_end"] = o.metric_end;
@@ -127,6 +130,10 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
     field(a, "atlas.", "code_layer", o.atlas.code_layer);  // later addition: absent = 0
   o.atlas.softplus_beta = 0;  // later addition: absent = ReLU, what older runs used
   if (a.contains("softplus_beta")) field(a, "atlas.", "softplus_beta", o.atlas.softplus_beta);
+  o.atlas.deform_layers = 0;  // later addition: absent = the paper's phi(x, f)
+  if (a.contains("deform_layers")) field(a, "atlas.", "deform_layers", o.atlas.deform_layers);
+  if (o.atlas.deform_layers < 0 || o.atlas.deform_layers > 64)
+    throw InputError(what + ": atlas.deform_layers must be in [0, 64]");
   const json& w = j.contains("weights") ? j["weights"] : json();
   field(w, "weights.", "surface_6d", o.weights.surface);
   field(w, "weights.", "chart_2d", o.weights.chart);
@@ -136,6 +143,10 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   field(w, "weights.", "code", o.weights.code);
   o.weights.metric = 0;  // later addition: absent = off, what older runs used
   if (w.contains("metric")) field(w, "weights.", "metric", o.weights.metric);
+  o.weights.coverage = 1;  // later addition: absent = Eq. 6's equal directions
+  if (w.contains("coverage")) field(w, "weights.", "coverage", o.weights.coverage);
+  if (!(o.weights.coverage >= 0) || !std::isfinite(o.weights.coverage))
+    throw InputError(what + ": weights.coverage must be finite and >= 0");
   const json& c = j.contains("components") ? j["components"] : json();
   field(c, "components.", "normals", o.components.normals);
   field(c, "components.", "repulsion", o.components.repulsion);
@@ -184,6 +195,9 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   o.template_share = 0;
   o.align_poses = false;  // later addition: runs before it were not aligned
   if (j.contains("align_poses")) field(j, "", "align_poses", o.align_poses);
+  o.pose_fit_steps = 0;
+  if (j.contains("pose_fit_steps")) field(j, "", "pose_fit_steps", o.pose_fit_steps);
+  if (o.pose_fit_steps < 0) throw InputError(what + ": pose_fit_steps must be >= 0");
   if (j.contains("template_steps")) field(j, "", "template_steps", o.template_steps);
   if (j.contains("template_share")) field(j, "", "template_share", o.template_share);
   o.code_lr_scale = 1;

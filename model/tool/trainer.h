@@ -99,6 +99,11 @@ struct FitOptions {
   // Collections: turn every shape into the pose of the first before fitting
   // (io/geometry/rigid_align.h, applied by the caller: model/tool/shape_input.h).
   bool align_poses = true;
+  // Collections, with align_poses: when a shape has more than one pose within
+  // 1.25x of the lowest Chamfer (a near-symmetric shape), each such pose gets a
+  // short fit, this many joint steps after a template start of shape 0, and the
+  // lowest loss wins (model/tool/pose_by_fit.h). 0: the rigid rules alone.
+  int64_t pose_fit_steps = 0;
   // Staged objective: until this fraction of the iterations, train phi and P
   // alone (no psi, no L_2D, no L_cycle; Table 1 row 9's objective), then the
   // full method. 0: the full method from the start, as the paper.
@@ -144,6 +149,7 @@ inline void apply_paper_method(FitOptions& o) {
   o.template_shape = 0;
   o.template_share = 0;
   o.align_poses = false;  // and takes the shapes in the poses given
+  o.pose_fit_steps = 0;
 }
 
 // The length of a fixed-M run when none is given: the default before the ramp.
