@@ -208,10 +208,14 @@ int main(int argc, char** argv) {
         throw std::runtime_error("shape counts differ");
       double sum = 0, worst = 0;
       for (size_t i = 1; i < r.size(); ++i) {
-        const Eigen::Matrix3d expected = a[i].transpose() * r0[i] * a[0];
-        const double e = jsa::rotation_angle_degrees(r[i].transpose() * expected);
+        // Relative poses (shape i's unit frame against shape 0's, r_i r_0^T):
+        // the fit's against the applied turns' composed with the reference's.
+        const Eigen::Matrix3d found_relative = r[i] * r[0].transpose();
+        const Eigen::Matrix3d expected = a[i].transpose() * r0[i] * r0[0].transpose() * a[0];
+        const double e = jsa::rotation_angle_degrees(found_relative.transpose() * expected);
         std::printf("shape %zu: found %.2f deg, expected %.2f deg, error %.2f deg\n", i,
-                    jsa::rotation_angle_degrees(r[i]), jsa::rotation_angle_degrees(expected), e);
+                    jsa::rotation_angle_degrees(found_relative),
+                    jsa::rotation_angle_degrees(expected), e);
         sum += e;
         worst = std::max(worst, e);
       }

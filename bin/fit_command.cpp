@@ -302,12 +302,9 @@ void run_fit(FitArgs& a, Team& team) {
       }
     } else {
       // align_to_first, for this rank's block only.
-      for (int i = std::max(1, block_first); i < block_last; ++i) {
-        set_rotation(shapes[size_t(i)], Eigen::Matrix3d::Identity());
-        poses[size_t(i)] =
-            rigid_align(shapes[size_t(i)].pool.leftCols(3), shapes[0].pool.leftCols(3));
-        set_rotation(shapes[size_t(i)], poses[size_t(i)].rotation);
-      }
+      poses[0].rotation = reference_frame(shapes[0]);
+      for (int i = std::max(1, block_first); i < block_last; ++i)
+        poses[size_t(i)] = align_to_reference(shapes[size_t(i)], shapes[0]);
     }
     if (many) {
       // Each rank's rotations of its own shapes, summed: rank 0 must find its own.
@@ -381,7 +378,9 @@ void run_fit(FitArgs& a, Team& team) {
   if (root && inputs.size() > 1) {
     const nlohmann::json r = {{"convention",
                                "unit-frame rows: x_unit = ((x_input - center) / scale) * rotation; "
-                               "shape 0 is the reference"},
+                               "shape 0 is the reference, turned into its principal axes "
+                               "(longest first, towards the larger third moment); the others "
+                               "onto it"},
                               {"shapes", rotations_json()}};
     write_file_atomically(dir + "/rotations.json",
                           [&](std::ostream& out) { out << r.dump(2) << "\n"; });
@@ -950,8 +949,9 @@ void add_fit(CLI::App& app) {
       ->check(CLI::Range(0.0, 0.95))
       ->check(kFinite);
   c->add_flag("--align,!--no-align", o.align_poses,
-              "Collections: turn every shape into the pose of the first (principal axes, ICP, "
-              "lowest Chamfer) before fitting; rotations.json lists them")
+              "Collections: turn the first shape onto its principal axes and every other into "
+              "its pose (principal axes, ICP, lowest Chamfer) before fitting; rotations.json "
+              "lists them")
       ->capture_default_str();
   c->add_option("--pose-fit", o.pose_fit_steps,
                 "Collections, with --align: a shape with several poses within 1.25x of the lowest "

@@ -297,3 +297,22 @@ TEST_CASE("poses within near_factor of the best are reported, one per pose",
   none.near_factor = 0;
   CHECK(jsa::rigid_align(two_bumps(3000, 13), two_bumps(3000, 14), none).near_poses.empty());
 }
+
+TEST_CASE("the canonical frame of a turned copy gives the same canonical points",
+          "[model][rigid_align]") {
+  const jsa::Block<double> p = lumpy(3000, 21);
+  const Eigen::Matrix3d r = jsa::canonical_rotation(p);
+  CHECK(r.determinant() == Approx(1).margin(1e-12));
+  CHECK((r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-12);
+  // Longest axis first: the canonical points' variances fall along x, y, z.
+  const jsa::Block<double> c = p * r;
+  const Eigen::RowVector3d var = c.colwise().squaredNorm();
+  CHECK(var(0) > var(1));
+  CHECK(var(1) > var(2));
+  jsa::Rng rng(22);
+  for (int trial = 0; trial < 5; ++trial) {
+    const Eigen::Matrix3d q = random_rotation(rng);
+    const jsa::Block<double> turned = p * q;
+    CHECK((turned * jsa::canonical_rotation(turned) - c).cwiseAbs().maxCoeff() < 1e-9);
+  }
+}

@@ -163,6 +163,24 @@ double share_mismatch(const Sets& s, const Eigen::Matrix3d& r, const Block<doubl
 
 }  // namespace
 
+Eigen::Matrix3d canonical_rotation(const Block<double>& points) {
+  JSA_CHECK(points.cols() == 3 && points.rows() >= 4, "canonical_rotation takes N x 3 points");
+  Eigen::Matrix3d axes;
+  Eigen::Vector3d values;
+  principal_axes(points, axes, values);
+  // Largest variance first: x R = coordinates along the axes, longest first.
+  Eigen::Matrix3d r;
+  for (int k = 0; k < 3; ++k) r.col(k) = axes.col(2 - k);
+  // Each of the first two axes points to the side of its larger third moment
+  // (the heavier tail); the third completes a proper rotation.
+  for (int k = 0; k < 2; ++k) {
+    const Eigen::VectorXd t = points * r.col(k);
+    if (t.array().cube().sum() < 0) r.col(k) *= -1;
+  }
+  r.col(2) = r.col(0).cross(r.col(1));
+  return r;
+}
+
 double rotation_angle_degrees(const Eigen::Matrix3d& r) {
   const double c = std::clamp((r.trace() - 1) / 2, -1.0, 1.0);
   return std::acos(c) * 180.0 / M_PI;

@@ -92,6 +92,15 @@ struct RigidAlignment {
 RigidAlignment rigid_align(const Block<double>& moving, const Block<double>& fixed,
                            const RigidAlignOptions& options = {});
 
+// The frame of a collection's reference shape, so that nothing downstream
+// depends on the pose its file happens to store: x -> x R puts the principal
+// axes of `points` (N x 3, centred) on x, y, z, longest first, each of the
+// first two pointing to the side of its larger third moment (det R = +1).
+// Rotating the points by Q gives Q^T R: the same canonical points, whatever
+// the input pose, unless two variances or a third moment nearly tie (a
+// symmetric body), where the frame is one of the ties.
+Eigen::Matrix3d canonical_rotation(const Block<double>& points);
+
 // The angle of a rotation matrix, in degrees (0 for the identity, 180 at most).
 double rotation_angle_degrees(const Eigen::Matrix3d& r);
 

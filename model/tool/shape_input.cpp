@@ -35,15 +35,34 @@ void set_rotation(RunInput& input, const Eigen::Matrix3d& rotation) {
   input.normalization.rotation = rotation;
 }
 
+Eigen::Matrix3d reference_frame(RunInput& reference) {
+  set_rotation(reference, Eigen::Matrix3d::Identity());
+  const Eigen::Matrix3d r = canonical_rotation(
+      reference.pool.topLeftCorner(std::min<Index>(reference.pool.rows(), 20000), 3));
+  set_rotation(reference, r);
+  return r;
+}
+
+RigidAlignment align_to_reference(RunInput& input, const RunInput& reference,
+                                  const RigidAlignOptions& options) {
+  // The input's own pose, as far as the file tells: its pose relative to the
+  // reference's file, which the reference's frame turns along with it.
+  const Eigen::Matrix3d frame = reference.normalization.rotation;
+  set_rotation(input, frame);
+  RigidAlignment a = rigid_align(input.pool.leftCols(3), reference.pool.leftCols(3), options);
+  a.rotation = frame * a.rotation;
+  for (Eigen::Matrix3d& r : a.near_poses) r = frame * r;
+  set_rotation(input, a.rotation);
+  return a;
+}
+
 std::vector<RigidAlignment> align_to_first(std::vector<RunInput>& inputs,
                                            const RigidAlignOptions& options) {
   std::vector<RigidAlignment> out(inputs.size());
   if (inputs.empty()) return out;
-  for (size_t i = 1; i < inputs.size(); ++i) {
-    set_rotation(inputs[i], Eigen::Matrix3d::Identity());
-    out[i] = rigid_align(inputs[i].pool.leftCols(3), inputs[0].pool.leftCols(3), options);
-    set_rotation(inputs[i], out[i].rotation);
-  }
+  out[0].rotation = reference_frame(inputs[0]);
+  for (size_t i = 1; i < inputs.size(); ++i)
+    out[i] = align_to_reference(inputs[i], inputs[0], options);
   return out;
 }
 

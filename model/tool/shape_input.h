@@ -25,11 +25,21 @@ Mesh load_shape(const std::string& spec);
 // normalization, so every output goes back to the input's own frame).
 void set_rotation(RunInput& input, const Eigen::Matrix3d& rotation);
 
-// The pose step of a collection: every shape after the first is rotated onto
-// the first (rigid_align on the pools in the unit frames; docs/collections.md).
-// Returns one alignment per shape (the first: the identity).
+// The pose step of a collection: the first shape turned into its canonical
+// frame (reference_frame), then every other shape rotated onto it
+// (align_to_reference; rigid_align on the pools in the unit frames;
+// docs/collections.md). Returns one alignment per shape (the first: its frame
+// alone). Shapes given in other poses get the same canonical unit frames.
 std::vector<RigidAlignment> align_to_first(std::vector<RunInput>& inputs,
                                            const RigidAlignOptions& options = {});
+// The reference's pool (and normalisation) turned into canonical_rotation of
+// its points (io/geometry/rigid_align.h); returns that rotation.
+Eigen::Matrix3d reference_frame(RunInput& reference);
+// `input` turned onto `reference` (already in its frame): rigid_align with the
+// input's own pose taken relative to the reference's file; the rotations
+// returned (and near_poses) are absolute, input file -> unit frame.
+RigidAlignment align_to_reference(RunInput& input, const RunInput& reference,
+                                  const RigidAlignOptions& options = {});
 
 // The template of a collection's template start (FitOptions::template_shape,
 // `--template-shape -1`): the medoid, the shape whose symmetric Chamfer

@@ -96,8 +96,9 @@ struct FitOptions {
   // reference. `jsatlas fit --template-shape -1` picks the medoid
   // (model/tool/shape_input.h) and stores its index here.
   int template_shape = 0;
-  // Collections: turn every shape into the pose of the first before fitting
-  // (io/geometry/rigid_align.h, applied by the caller: model/tool/shape_input.h).
+  // Collections: turn the first shape onto its principal axes and every other
+  // into its pose before fitting (io/geometry/rigid_align.h, applied by the
+  // caller: model/tool/shape_input.h).
   bool align_poses = true;
   // Collections, with align_poses: when a shape has more than one pose within
   // 1.25x of the lowest Chamfer (a near-symmetric shape), each such pose gets a
