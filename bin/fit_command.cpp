@@ -300,25 +300,23 @@ void run_fit(FitArgs& a, Team& team) {
         pose_fit_seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - f0).count();
       }
-    } else {
-      // align_to_first, for this rank's block only.
-      poses[0].rotation = reference_frame(shapes[0]);
-      for (int i = std::max(1, block_first); i < block_last; ++i)
-        poses[size_t(i)] = align_to_reference(shapes[size_t(i)], shapes[0]);
     }
     if (many) {
-      // Each rank's rotations of its own shapes, summed: rank 0 must find its own.
-      std::vector<double> owned(9 * inputs.size(), 0.0);
-      for (int i = block_first; i < block_last; ++i)
-        for (int k = 0; k < 9; ++k)
-          owned[size_t(9 * i + k)] = poses[size_t(i)].rotation(k / 3, k % 3);
-      team.sum_in_rank_order(owned.data(), owned.size());
+      // Rank 0 poses every shape (the near ties are settled by the whole
+      // collection, which no other rank holds); the others take its rotations
+      // (summed with zeros: a broadcast) and turn their own shapes.
+      std::vector<double> rotations(9 * inputs.size(), 0.0);
       if (root)
         for (size_t i = 0; i < inputs.size(); ++i)
           for (int k = 0; k < 9; ++k)
-            if (owned[9 * i + size_t(k)] != poses[i].rotation(k / 3, k % 3))
-              throw std::runtime_error("fit: the MPI ranks disagree on the pose of shape " +
-                                       std::to_string(i) + " (" + inputs[i] + ")");
+            rotations[9 * i + size_t(k)] = poses[i].rotation(k / 3, k % 3);
+      team.sum_in_rank_order(rotations.data(), rotations.size());
+      if (!root)
+        for (size_t i = 0; i < inputs.size(); ++i) {
+          for (int k = 0; k < 9; ++k)
+            poses[i].rotation(k / 3, k % 3) = rotations[9 * i + size_t(k)];
+          if (shapes[i].pool.rows() > 0) set_rotation(shapes[i], poses[i].rotation);
+        }
     }
     if (!a.quiet) {
       std::cerr << "fit: poses aligned to shape 0 in "
@@ -362,6 +360,8 @@ void run_fit(FitArgs& a, Team& team) {
                 {"chamfer", poses[i].near_chamfers[k]},
                 {"degrees_from_chosen",
                  rotation_angle_degrees(poses[i].near_poses[k].transpose() * poses[i].rotation)}};
+            if (k < poses[i].near_collection.size())
+              n["collection_chamfer"] = poses[i].near_collection[k];
             if (k < pose_fits[i].losses.size()) {
               n["fit_loss"] = pose_fits[i].losses[k];
               n["fit_surface"] = pose_fits[i].surfaces[k];

@@ -67,3 +67,38 @@ TEST_CASE("pose step: a collection in other poses gets the same unit frames", "[
   }
   CHECK(rotation_angle_degrees(ra[0].rotation) > 1);  // the stored body is not in its axes
 }
+
+TEST_CASE("pose step: a near tie is settled by the rest of the collection", "[pose]") {
+  // Shape 0 is symmetric under a half turn about z (two bumps), so it cannot
+  // tell shape 1's two poses apart; shapes 2 and 3 (one bump, as shape 1) can.
+  Eigen::Matrix3d half = Eigen::Matrix3d::Identity();
+  half(0, 0) = half(1, 1) = -1;
+  RunInput reference = body(3000, 11, 0.6);
+  for (Index i = 0; i < reference.pool.rows(); i += 2)
+    reference.pool.row(i) =
+        (reference.pool.row(i) * Eigen::DiagonalMatrix<double, 6>(-1, -1, 1, -1, -1, 1)).eval();
+  std::vector<RunInput> inputs{reference, body(3000, 12, 0.6), body(3000, 13, 0.6),
+                               body(3000, 14, 0.6)};
+  std::vector<RigidAlignment> poses(4);
+  // Shape 1 stands half turned, and both poses are listed as near ties.
+  set_rotation(inputs[1], half);
+  poses[1].rotation = half;
+  poses[1].near_poses = {half, Eigen::Matrix3d::Identity()};
+  poses[1].near_chamfers = {0.01, 0.0101};
+  settle_near_ties(inputs, poses);
+  CHECK(rotation_angle_degrees(poses[1].rotation) < 1e-9);
+  CHECK(rotation_angle_degrees(inputs[1].normalization.rotation) < 1e-9);
+  REQUIRE(poses[1].near_collection.size() == 2);
+  CHECK(poses[1].near_collection[1] < 0.8 * poses[1].near_collection[0]);
+  // Its pool is back in the pose the others share.
+  CHECK((inputs[1].pool - body(3000, 12, 0.6).pool).cwiseAbs().maxCoeff() < 1e-12);
+
+  // A shape whose own input pose was kept is trusted and stays.
+  std::vector<RunInput> again{reference, body(3000, 12, 0.6), body(3000, 13, 0.6),
+                              body(3000, 14, 0.6)};
+  set_rotation(again[1], half);
+  poses[1].rotation = half;
+  poses[1].kept_input = true;
+  settle_near_ties(again, poses);
+  CHECK(rotation_angle_degrees(poses[1].rotation.transpose() * half) < 1e-9);
+}

@@ -84,6 +84,9 @@ struct RigidAlignment {
   // is more than one, the choice between them was close.
   std::vector<Eigen::Matrix3d> near_poses;
   std::vector<double> near_chamfers;
+  // Per near pose, its mean Chamfer to a whole collection, when a caller
+  // settles the tie that way (model/tool/shape_input.h, settle_near_ties).
+  std::vector<double> near_collection;
   double angle_degrees() const;  // of `rotation`
 };
 

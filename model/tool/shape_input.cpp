@@ -56,6 +56,59 @@ RigidAlignment align_to_reference(RunInput& input, const RunInput& reference,
   return a;
 }
 
+namespace {
+
+// The symmetric Chamfer distance (mean squared, both ways) of two point sets.
+double symmetric_chamfer(const Block<double>& a, const Block<double>& b) {
+  auto one_way = [](const Block<double>& x, const Block<double>& y) {
+    std::vector<int> index;
+    std::vector<double> d2;
+    nearest(x, y, index, &d2);
+    double sum = 0;
+    for (double d : d2) sum += d;
+    return sum / double(d2.size());
+  };
+  return one_way(a, b) + one_way(b, a);
+}
+
+Block<double> first_points(const Block<double>& pool, Index samples) {
+  return pool.topLeftCorner(std::min(samples, pool.rows()), 3);
+}
+
+}  // namespace
+
+void settle_near_ties(std::vector<RunInput>& inputs, std::vector<RigidAlignment>& poses,
+                      Index samples) {
+  const size_t n = inputs.size();
+  for (size_t i = 1; i < n; ++i) poses[i].near_collection.assign(poses[i].near_poses.size(), 0.0);
+  for (int round = 0; round < 3; ++round) {
+    bool changed = false;
+    for (size_t i = 1; i < n; ++i) {
+      RigidAlignment& a = poses[i];
+      if (a.near_poses.size() < 2 || a.kept_input) continue;  // a file's own pose is trusted
+      // Shape i's points in each near pose: its pool turned from the current pose.
+      const Block<double> here = first_points(inputs[i].pool, samples);
+      size_t pick = 0;
+      for (size_t k = 0; k < a.near_poses.size(); ++k) {
+        const Block<double> p =
+            here * (inputs[i].normalization.rotation.transpose() * a.near_poses[k]);
+        double sum = 0;
+        for (size_t j = 0; j < n; ++j)
+          if (j != i) sum += symmetric_chamfer(p, first_points(inputs[j].pool, samples));
+        a.near_collection[k] = sum / double(n - 1);
+        if (a.near_collection[k] < a.near_collection[pick]) pick = k;
+      }
+      if (rotation_angle_degrees(a.near_poses[pick].transpose() * a.rotation) > 10) {
+        a.rotation = a.near_poses[pick];
+        a.chamfer = a.near_chamfers[pick];
+        set_rotation(inputs[i], a.rotation);
+        changed = true;
+      }
+    }
+    if (!changed) break;
+  }
+}
+
 std::vector<RigidAlignment> align_to_first(std::vector<RunInput>& inputs,
                                            const RigidAlignOptions& options) {
   std::vector<RigidAlignment> out(inputs.size());
@@ -63,6 +116,7 @@ std::vector<RigidAlignment> align_to_first(std::vector<RunInput>& inputs,
   out[0].rotation = reference_frame(inputs[0]);
   for (size_t i = 1; i < inputs.size(); ++i)
     out[i] = align_to_reference(inputs[i], inputs[0], options);
+  if (inputs.size() > 2) settle_near_ties(inputs, out);
   return out;
 }
 
@@ -76,18 +130,9 @@ MedoidChoice medoid_shape(const std::vector<Block<double>>& pools, Index samples
     const Index rows = std::min<Index>(samples, pools[i].rows());
     points[i] = pools[i].topLeftCorner(rows, 3);
   }
-  // One direction of the Chamfer distance: mean squared distance from a to b.
-  auto one_way = [](const Block<double>& a, const Block<double>& b) {
-    std::vector<int> index;
-    std::vector<double> d2;
-    nearest(a, b, index, &d2);
-    double sum = 0;
-    for (double d : d2) sum += d;
-    return sum / double(d2.size());
-  };
   for (size_t i = 0; i < n; ++i)
     for (size_t j = i + 1; j < n; ++j) {
-      const double d = one_way(points[i], points[j]) + one_way(points[j], points[i]);
+      const double d = symmetric_chamfer(points[i], points[j]);
       c.sums[i] += d;
       c.sums[j] += d;
     }

@@ -32,6 +32,17 @@ void set_rotation(RunInput& input, const Eigen::Matrix3d& rotation);
 // alone). Shapes given in other poses get the same canonical unit frames.
 std::vector<RigidAlignment> align_to_first(std::vector<RunInput>& inputs,
                                            const RigidAlignOptions& options = {});
+// Near ties (RigidAlignment::near_poses, a near-symmetric shape: an ant end to
+// end) settled by the whole collection rather than the reference alone: each
+// such shape takes the near pose whose mean symmetric Chamfer distance to all
+// the other shapes, in their poses, is lowest (near_collection), in rounds
+// until no pose changes (at most 3). Pairs of near-symmetric shapes disagree
+// with each other (docs/collections.md), so the majority of the family decides.
+// A shape whose own input pose was kept (RigidAlignOptions::keep_input) stays.
+// align_to_first calls it for three shapes or more.
+void settle_near_ties(std::vector<RunInput>& inputs, std::vector<RigidAlignment>& poses,
+                      Index samples = 3000);
+
 // The reference's pool (and normalisation) turned into canonical_rotation of
 // its points (io/geometry/rigid_align.h); returns that rotation.
 Eigen::Matrix3d reference_frame(RunInput& reference);
