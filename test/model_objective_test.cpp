@@ -64,6 +64,24 @@ double worst_central_difference(Atlas<double>& atlas, const std::vector<double>&
   return worst;
 }
 
+// The worst central-difference error over every 3rd entry of the named
+// parameter blocks, against the analytic gradient of the collection objective.
+double worst_over_blocks(Atlas<double>& atlas, const std::vector<Block<double>>& targets,
+                         const std::vector<const char*>& names, Tape<double>& tape, int& checked) {
+  const Components c;
+  objective_value(atlas, targets, c, tape, true);
+  const std::vector<double> analytic = atlas.params.grads();
+  double worst = 0;
+  for (const char* name : names) {
+    const auto& e = atlas.params.entry(atlas.params.find(name));
+    worst = std::max(
+        worst, worst_central_difference(
+                   atlas, analytic, e.offset, e.offset + size_t(e.rows * e.cols), 3,
+                   [&]() { return objective_value(atlas, targets, c, tape, false); }, checked));
+  }
+  return worst;
+}
+
 }  // namespace
 
 TEST_CASE("objective: gradients of L_single match central differences", "[objective]") {
@@ -117,19 +135,11 @@ TEST_CASE(
   }
   const std::vector<Block<double>> targets{random_targets(32, ao.alpha, 3),
                                            random_targets(32, ao.alpha, 4)};
-  const Components c;
   Tape<double> tape;
-  objective_value(atlas, targets, c, tape, true);
-  const std::vector<double> analytic = atlas.params.grads();
-  double worst = 0;
   int checked = 0;
-  for (const char* name : {"codes.phi", "codes.psi", "phi.wf", "psi.wf", "domain.mu", "phi.w0"}) {
-    const auto& e = atlas.params.entry(atlas.params.find(name));
-    worst = std::max(
-        worst, worst_central_difference(
-                   atlas, analytic, e.offset, e.offset + size_t(e.rows * e.cols), 3,
-                   [&]() { return objective_value(atlas, targets, c, tape, false); }, checked));
-  }
+  const double worst = worst_over_blocks(
+      atlas, targets, {"codes.phi", "codes.psi", "phi.wf", "psi.wf", "domain.mu", "phi.w0"}, tape,
+      checked);
   INFO(checked << " entries, worst error/tolerance " << worst);
   CHECK(checked > 40);
   CHECK(worst <= 1.0);
@@ -412,20 +422,13 @@ TEST_CASE("objective: phi as a deformation per shape (deform_layers): gradients 
     atlas.params.value(atlas.params.find(name)) *= 100.0;
   const std::vector<Block<double>> targets{random_targets(32, ao.alpha, 3),
                                            random_targets(32, ao.alpha, 4)};
-  const Components c;
   Tape<double> tape;
-  objective_value(atlas, targets, c, tape, true);
-  const std::vector<double> analytic = atlas.params.grads();
-  double worst = 0;
   int checked = 0;
-  for (const char* name : {"codes.phi", "phi.deform.wf", "phi.deform.w0", "phi.deform.w2",
-                           "phi.deform.b1", "phi.w0", "phi.w2", "psi.wf", "domain.mu"}) {
-    const auto& e = atlas.params.entry(atlas.params.find(name));
-    worst = std::max(
-        worst, worst_central_difference(
-                   atlas, analytic, e.offset, e.offset + size_t(e.rows * e.cols), 3,
-                   [&]() { return objective_value(atlas, targets, c, tape, false); }, checked));
-  }
+  const double worst =
+      worst_over_blocks(atlas, targets,
+                        {"codes.phi", "phi.deform.wf", "phi.deform.w0", "phi.deform.w2",
+                         "phi.deform.b1", "phi.w0", "phi.w2", "psi.wf", "domain.mu"},
+                        tape, checked);
   INFO(checked << " entries, worst error/tolerance " << worst);
   CHECK(checked > 60);
   CHECK(worst <= 1.0);

@@ -4,7 +4,7 @@
 #include <vector>
 
 #include "engine/rng.h"
-#include "io/geometry/nearest.h"
+#include "losses/chamfer.h"
 
 namespace jsa {
 
@@ -46,15 +46,7 @@ double surface_distance(Atlas<float>& atlas, int shape, const Block<double>& poo
   fitted.leftCols(3) = points;
   fitted.rightCols(3) = alpha * normals;
   target.rightCols(3) *= alpha;
-  auto one_way = [](const Block<double>& a, const Block<double>& b) {
-    std::vector<int> index;
-    std::vector<double> d2;
-    nearest(a, b, index, &d2);
-    double sum = 0;
-    for (double d : d2) sum += d;
-    return sum / double(d2.size());
-  };
-  return one_way(fitted, target) + one_way(target, fitted);
+  return chamfer_distance(fitted, target);
 }
 
 }  // namespace

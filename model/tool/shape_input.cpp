@@ -6,6 +6,7 @@
 #include "io/geometry/nearest.h"
 #include "io/geometry/surface_sampling.h"
 #include "io/mesh_io.h"
+#include "losses/chamfer.h"
 
 namespace jsa {
 
@@ -60,15 +61,7 @@ namespace {
 
 // The symmetric Chamfer distance (mean squared, both ways) of two point sets.
 double symmetric_chamfer(const Block<double>& a, const Block<double>& b) {
-  auto one_way = [](const Block<double>& x, const Block<double>& y) {
-    std::vector<int> index;
-    std::vector<double> d2;
-    nearest(x, y, index, &d2);
-    double sum = 0;
-    for (double d : d2) sum += d;
-    return sum / double(d2.size());
-  };
-  return one_way(a, b) + one_way(b, a);
+  return chamfer_distance(a, b);
 }
 
 Block<double> first_points(const Block<double>& pool, Index samples) {
