@@ -54,7 +54,7 @@ struct FitArgs {
   // Whether --iters and --schedule were given: collections and --preset paper
   // have defaults of their own (kFixedScheduleIterations in model/tool/trainer.h).
   bool iters_given = false, schedule_given = false;
-  bool points_given = false, gaussians_given = false, width_given = false;
+  bool points_given = false, gaussians_given = false, width_given = false, deform_given = false;
 };
 
 std::string format_duration(double seconds) {
@@ -232,6 +232,7 @@ void run_fit(FitArgs& a, Team& team) {
       if (!a.points_given) o.points = kCollectionPoints;
       if (!a.gaussians_given) o.atlas.gaussians = kCollectionGaussians;
       if (!a.width_given) o.atlas.width = kCollectionWidth;
+      if (!a.deform_given) o.atlas.deform_layers = kCollectionDeformLayers;
     }
   }
   if (a.threads >= 0) o.threads = a.threads;
@@ -899,7 +900,8 @@ void add_fit(CLI::App& app) {
       ->check(CLI::Range(0, 1));
   c->add_option("--deform-layers", o.atlas.deform_layers,
                 "Collections: phi_i(x) = phi(x) + D(phi(x), f_i), each shape a deformation of "
-                "one surface by an MLP D of this many hidden layers (0: phi(x, f_i), the paper's)")
+                "one surface by an MLP D of this many hidden layers (0: phi(x, f_i), the paper's; "
+                "collections: " + std::to_string(kCollectionDeformLayers) + ")")
       ->capture_default_str()
       ->check(CLI::Range(0, 64));
   c->add_option("--reseed", o.reseed_every,
@@ -994,6 +996,7 @@ void add_fit(CLI::App& app) {
     a->points_given = c->count("--points") > 0;
     a->gaussians_given = c->count("--gaussians") > 0;
     a->width_given = c->count("--width") > 0;
+    a->deform_given = c->count("--deform-layers") > 0;
     std::unique_ptr<Team> team = join_team();
     if (team->size() == 1) return run_fit(*a, *team);
     try {

@@ -151,6 +151,7 @@ inline void apply_paper_method(FitOptions& o) {
   o.template_share = 0;
   o.align_poses = false;  // and takes the shapes in the poses given
   o.pose_fit_steps = 0;
+  o.atlas.deform_layers = 0;  // phi(x, f_i), the paper's conditioning
 }
 
 // The length of a fixed-M run when none is given: the default before the ramp.
@@ -168,6 +169,12 @@ constexpr int64_t kFixedScheduleIterations = 5000;
 constexpr Index kCollectionPoints = 1000;
 constexpr int kCollectionGaussians = 1000;
 constexpr int kCollectionWidth = 64;
+// ... and phi_i(x) = phi(x) + D(phi(x), f_i) with D of 3 x 64 (AtlasOptions::
+// deform_layers): at five minutes of two cores, one run after the other with
+// phi(x, f_i), ant 8.89 -> 5.87 on the chart rule with every reconstruction
+// closer, teddy level (10.44 -> 10.61), for 1.2-1.6x the step and about 110 MB
+// more for four shapes (docs/collections.md, ninth round).
+constexpr int kCollectionDeformLayers = 3;
 
 // `--preset paper`: the paper's method at the paper's sizes (Sec. 3,
 // implementation details): M = K = 10^4, phi and psi 5 x 256. Iterations,
