@@ -901,7 +901,8 @@ void add_fit(CLI::App& app) {
   c->add_option("--deform-layers", o.atlas.deform_layers,
                 "Collections: phi_i(x) = phi(x) + D(phi(x), f_i), each shape a deformation of "
                 "one surface by an MLP D of this many hidden layers (0: phi(x, f_i), the paper's; "
-                "collections: " + std::to_string(kCollectionDeformLayers) + ")")
+                "collections: " +
+                    std::to_string(kCollectionDeformLayers) + ")")
       ->capture_default_str()
       ->check(CLI::Range(0, 64));
   c->add_option("--reseed", o.reseed_every,
