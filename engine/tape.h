@@ -11,6 +11,16 @@
 // iteration builds the same graph with the same shapes, so Eigen's resize() is a
 // no-op and nothing is reallocated after the first step.
 //
+// Gradients are lent, not owned. A node's gradient block is taken from a pool
+// when the first pull-back writes into it (zeroed then, not all at once before
+// the sweep) and handed back as soon as the node's own pull-back has run: in
+// the reverse sweep a gradient is live only between its first consumer and its
+// producer, so the sweep holds a few blocks at a time where it used to hold one
+// per node (about half of a training step's memory). Leaves (no pull-back)
+// keep theirs until the next backward() or clear(), for the caller to read.
+// A node nobody wrote a gradient into has a zero gradient: its pull-back is
+// skipped, since pull-backs are linear in it.
+//
 // There is no global tape: every op takes the tape it writes to.
 #pragma once
 #include <functional>
@@ -60,8 +70,25 @@ class Tape {
 
   const Block<T>& value(Var v) const { return nodes_[check(v)].value; }
   Block<T>& value(Var v) { return nodes_[check(v)].value; }
-  Block<T>& grad(Var v) { return nodes_[check(v)].grad; }
-  const Block<T>& grad(Var v) const { return nodes_[check(v)].grad; }
+  // d(loss)/d(node). In a pull-back: the node's gradient, zero until written.
+  // After backward(): a leaf's; an inner node's has been handed back (see the
+  // header comment) and asking for it is an error.
+  Block<T>& grad(Var v) {
+    Node& n = nodes_[check(v)];
+    if (!n.grad_live) {
+      JSA_CHECK(sweeping_ && !n.grad_returned,
+                "the gradient of node " << v.id << " is not kept: only leaves' gradients "
+                                        << "outlive backward()");
+      lend(n);
+    }
+    return n.grad;
+  }
+  const Block<T>& grad(Var v) const {
+    const Node& n = nodes_[check(v)];
+    JSA_CHECK(n.grad_live, "node " << v.id << " has no gradient (an inner node after backward(), "
+                                   << "or one backward() never reached)");
+    return n.grad;
+  }
   bool needs_grad(Var v) const { return nodes_[check(v)].needs_grad; }
   Index rows(Var v) const { return value(v).rows(); }
   Index cols(Var v) const { return value(v).cols(); }
@@ -74,15 +101,24 @@ class Tape {
   // written, seed dloss = 1, then run the pull-backs newest first.
   void backward(Var loss) {
     JSA_CHECK(rows(loss) == 1 && cols(loss) == 1, "backward() needs a scalar loss");
-    for (int i = 0; i < size_; ++i) {
-      Node& n = nodes_[i];
-      if (n.needs_grad) n.grad.setZero(n.value.rows(), n.value.cols());
-    }
+    return_all_grads();  // a second backward() on one graph starts from zero again
     if (!needs_grad(loss)) return;
+    struct Sweep {  // sweeping_ is reset even when a pull-back throws
+      bool& on;
+      explicit Sweep(bool& flag) : on(flag) { on = true; }
+      ~Sweep() { on = false; }
+    } sweep(sweeping_);
     grad(loss)(0, 0) = T(1);
     for (int i = loss.id; i >= 0; --i) {
       Node& n = nodes_[i];
-      if (n.needs_grad && n.backward) n.backward(*this, Var{i});
+      if (!n.needs_grad || !n.backward || !n.grad_live) continue;
+      n.backward(*this, Var{i});
+      give_back(n);
+    }
+    // Leaves the loss does not reach have a zero gradient to read.
+    for (int i = 0; i < size_; ++i) {
+      Node& n = nodes_[i];
+      if (n.needs_grad && !n.backward && !n.grad_live) lend(n);
     }
   }
 
@@ -97,6 +133,7 @@ class Tape {
 
   // Forgets the graph, keeps the storage (see the header comment).
   void clear() {
+    return_all_grads();
     for (int i = 0; i < size_; ++i) nodes_[i].backward = nullptr;
     size_ = 0;
     kept_size_ = 0;
@@ -111,10 +148,11 @@ class Tape {
   void set_parameter_grads(std::vector<T>* grads) { parameter_grads_ = grads; }
   std::vector<T>* parameter_grads() const { return parameter_grads_; }
 
-  // Bytes held by node values and gradients (for memory reports).
+  // Bytes held by node values and gradients, lent or in the pool (for memory reports).
   size_t bytes() const {
     size_t b = 0;
     for (const Node& n : nodes_) b += sizeof(T) * size_t(n.value.size() + n.grad.size());
+    for (const Block<T>& g : pool_) b += sizeof(T) * size_t(g.size());
     return b;
   }
 
@@ -123,7 +161,45 @@ class Tape {
     Block<T> value, grad;
     Backward backward;
     bool needs_grad = false;
+    bool grad_live = false;      // holds a lent gradient block
+    bool grad_returned = false;  // its pull-back ran and the block went back
   };
+
+  // A zeroed block of the node's shape: one of the pool's of that size if
+  // there is one, else any (resized), else a new one. The sweep asks for the
+  // same sizes in the same order every step, so after the first step no block
+  // is allocated; when the sizes change (a schedule's M) the old blocks are
+  // resized rather than kept.
+  void lend(Node& n) {
+    const Index rows = n.value.rows(), cols = n.value.cols();
+    size_t pick = pool_.size();
+    for (size_t k = pool_.size(); k-- > 0;)
+      if (pool_[k].size() == rows * cols) {
+        pick = k;
+        break;
+      }
+    if (pick == pool_.size() && !pool_.empty()) pick = pool_.size() - 1;
+    if (pick < pool_.size()) {
+      n.grad.swap(pool_[pick]);
+      pool_[pick].swap(pool_.back());
+      pool_.pop_back();
+    }
+    n.grad.setZero(rows, cols);
+    n.grad_live = true;
+  }
+  void give_back(Node& n) {
+    pool_.emplace_back();
+    pool_.back().swap(n.grad);
+    n.grad_live = false;
+    n.grad_returned = true;
+  }
+  void return_all_grads() {
+    for (int i = 0; i < size_; ++i) {
+      Node& n = nodes_[i];
+      if (n.grad_live) give_back(n);
+      n.grad_returned = false;
+    }
+  }
 
   int check(Var v) const {
     JSA_CHECK(v.id >= 0 && v.id < size_, "stale or invalid Var " << v.id);
@@ -135,6 +211,7 @@ class Tape {
     n.value.resize(rows, cols);
     n.needs_grad = needs_grad;
     n.backward = nullptr;
+    n.grad_live = n.grad_returned = false;
     return Var{size_++};
   }
   Var leaf_impl(const Block<T>& value, bool needs_grad) {
@@ -148,6 +225,8 @@ class Tape {
   std::vector<std::vector<int>> kept_;
   int kept_size_ = 0;
   std::vector<T>* parameter_grads_ = nullptr;
+  std::vector<Block<T>> pool_;  // gradient blocks not lent to any node
+  bool sweeping_ = false;       // inside backward()
 };
 
 }  // namespace jsa
