@@ -97,8 +97,9 @@ class Tape {
     return value(v)(0, 0);
   }
 
-  // Reverse accumulation from a 1 x 1 node: zero every gradient that will be
-  // written, seed dloss = 1, then run the pull-backs newest first.
+  // Reverse accumulation from a 1 x 1 node: seed dloss = 1, then run the
+  // pull-backs newest first, each gradient lent at its first write and given
+  // back after its node's pull-back (header comment).
   void backward(Var loss) {
     JSA_CHECK(rows(loss) == 1 && cols(loss) == 1, "backward() needs a scalar loss");
     return_all_grads();  // a second backward() on one graph starts from zero again
