@@ -3,6 +3,7 @@
 // --checkpoint-every iterations and at the end) and DIR/domain_mesh.obj.
 // Under `mpirun -np P` a collection's shapes are split over P ranks
 // (docs/mpi.md); rank 0 prints and writes every file.
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -13,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <vector>
@@ -93,6 +95,7 @@ auto with_flag_names(F&& f) {
       {"reseed_every", "--reseed"},
       {"template_steps", "--template-steps"},
       {"template_share", "--template-share"},
+      {"template_max_steps", "--template-max-steps"},
       {"template_shape", "--template-shape"},
       {"chart_from", "--chart-from"},
       {"code_lr_scale", "--code-lr-scale"},
@@ -506,9 +509,11 @@ void run_fit(FitArgs& a, Team& team) {
       // template 8 of 10 minutes instead of 3).
       const double target = o.template_share * a.minutes * 60.0;
       const int64_t stretch = std::max<int64_t>(25, int64_t(target / per / 25.0));
+      const int64_t cap =
+          o.template_max_steps > 0 ? o.template_max_steps : std::numeric_limits<int64_t>::max();
       for (;;) {
         const double left = target - std::chrono::duration<double>(clock::now() - t0).count();
-        const int64_t n = std::min<int64_t>(stretch, int64_t(left / per));
+        const int64_t n = std::min({stretch, int64_t(left / per), cap - trainer.template_done()});
         if (n < 1 || g_signal) break;
         const auto s0 = clock::now();
         trainer.train_template(n, cancelled);
@@ -725,6 +730,7 @@ void add_fit(CLI::App& app) {
   // run: measured on the SHREC ants and teddies (docs/collections.md).
   o.template_steps = -1;
   o.template_share = 0.3;
+  o.template_max_steps = kTemplateMaxSteps;
   // ... of its medoid, the most typical shape (docs/collections.md, sixth round).
   o.template_shape = -1;
   CLI::App* c = app.add_subcommand(
@@ -951,6 +957,11 @@ void add_fit(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 0.95))
       ->check(kFinite);
+  c->add_option("--template-max-steps", o.template_max_steps,
+                "Collections, with --template-steps -1: at most this many template steps, the "
+                "rest of the share going to the joint training (0: no cap)")
+      ->capture_default_str()
+      ->check(CLI::Range(int64_t(0), int64_t(100000000)));
   c->add_flag("--align,!--no-align", o.align_poses,
               "Collections: turn the first shape onto its principal axes and every other into "
               "its pose (principal axes, ICP, lowest Chamfer) before fitting; rotations.json "

@@ -285,4 +285,12 @@ TEST_CASE("cli: the schedule's flags are saved, collections keep M fixed, a shor
   INFO(r.output);
   REQUIRE(r.code == 0);
   CHECK(settings(dir + "_budget")["iterations"] > 25);
+  // Under --minutes the template start takes its share of the time, but no
+  // more than --template-max-steps; the joint training gets the rest.
+  r = run("fit builtin:sphere builtin:torus -o " + dir +
+          "_capped --minutes 0.05 --no-align --template-shape 0 --template-max-steps 40" + kSmall);
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  CHECK(settings(dir + "_capped")["template_steps"] == 40);
+  CHECK(settings(dir + "_capped")["template_max_steps"] == 40);
 }

@@ -208,6 +208,13 @@ TEST_CASE("schedule: the template start takes the first level and its share of t
   CHECK(jsa::Trainer::template_steps_for(o, 1000, 2) == std::llround(0.3 / 0.7 * 1000 * 2 * ratio));
   o.schedule.kind = "step";
   CHECK(jsa::Trainer::template_steps_for(o, 1000, 2) == std::llround(0.3 / 0.7 * 1000 * 2));
+  // template_max_steps caps the share (857 steps above), and only when it binds.
+  o.template_max_steps = 500;
+  CHECK(jsa::Trainer::template_steps_for(o, 1000, 2) == 500);
+  o.template_max_steps = 5000;
+  CHECK(jsa::Trainer::template_steps_for(o, 1000, 2) == std::llround(0.3 / 0.7 * 1000 * 2));
+  o.template_steps = 7000;  // an explicit length is not capped
+  CHECK(jsa::Trainer::template_steps_for(o, 1000, 2) == 7000);
 }
 
 TEST_CASE("schedule: out-of-range settings are refused naming the setting", "[schedule][trainer]") {

@@ -89,6 +89,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["align_poses"] = o.align_poses;
   j["pose_fit_steps"] = o.pose_fit_steps;
   j["template_share"] = o.template_share;
+  j["template_max_steps"] = o.template_max_steps;
   j["chart_from"] = o.chart_from;
   j["metric_end"] = o.metric_end;
   j["metric_conformal"] = o.metric_conformal;
@@ -217,6 +218,9 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (j.contains("chart_from")) field(j, "", "chart_from", o.chart_from);
   if (!(o.chart_from >= 0 && o.chart_from <= 1))
     throw InputError(what + ": chart_from must be in [0, 1]");
+  o.template_max_steps = 0;  // later addition: absent = no cap
+  if (j.contains("template_max_steps")) field(j, "", "template_max_steps", o.template_max_steps);
+  if (o.template_max_steps < 0) throw InputError(what + ": template_max_steps must be >= 0");
   if (o.template_steps < -1 || !(o.template_share >= 0 && o.template_share < 1))
     throw InputError(what + ": template_steps must be >= -1 and template_share in [0, 1)");
   field(j, "", "pool", o.pool);

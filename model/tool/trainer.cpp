@@ -256,8 +256,9 @@ int64_t Trainer::template_steps_for(const FitOptions& o, int64_t iterations, int
   // shape instead of N); a joint step costs on average the ramp's cost ratio
   // times that first one (1 at a fixed M).
   const double ratio = scheduled_cost_ratio(o.schedule, o.points, kStepOverheadPoints);
-  return int64_t(std::llround(o.template_share / (1 - o.template_share) * double(iterations) *
-                              shapes * ratio));
+  const int64_t steps = int64_t(std::llround(o.template_share / (1 - o.template_share) *
+                                             double(iterations) * shapes * ratio));
+  return o.template_max_steps > 0 ? std::min(steps, o.template_max_steps) : steps;
 }
 
 void Trainer::train_template(int64_t steps, const std::function<bool()>& cancelled) {

@@ -122,6 +122,11 @@ struct FitOptions {
   // Share of the run's cost spent on the template (when template_steps < 0).
   // `jsatlas fit` starts collections with -1 and 0.3 (docs/collections.md).
   double template_share = 0;
+  // ... and at most this many template steps (0: no cap). The template is one
+  // shape at a constant learning rate, finished long before a long budget's
+  // share is spent; past that its steps are the joint training's loss
+  // (docs/collections.md, tenth round). `jsatlas fit` sets kTemplateMaxSteps.
+  int64_t template_max_steps = 0;
   // Collections: a step's shapes split over the threads, each thread with a
   // tape and a gradient of its own, summed in thread order (Trainer::train_on).
   // At a collection's sizes (M = 1000 rows, 64 units) one shape's kernels are
@@ -149,6 +154,7 @@ inline void apply_paper_method(FitOptions& o) {
   o.template_steps = 0;                   // the paper trains all shapes jointly from the start
   o.template_shape = 0;
   o.template_share = 0;
+  o.template_max_steps = 0;
   o.align_poses = false;  // and takes the shapes in the poses given
   o.pose_fit_steps = 0;
   o.atlas.deform_layers = 0;  // phi(x, f_i), the paper's conditioning
@@ -175,6 +181,9 @@ constexpr int kCollectionWidth = 64;
 // closer, teddy level (10.44 -> 10.61), for 1.2-1.6x the step and about 110 MB
 // more for four shapes (docs/collections.md, ninth round).
 constexpr int kCollectionDeformLayers = 3;
+// ... and a template start of at most this many steps (FitOptions::
+// template_max_steps): PROVISIONAL, measured in docs/collections.md, tenth round.
+constexpr int64_t kTemplateMaxSteps = 9000;
 
 // `--preset paper`: the paper's method at the paper's sizes (Sec. 3,
 // implementation details): M = K = 10^4, phi and psi 5 x 256. Iterations,
