@@ -182,7 +182,11 @@ constexpr int kCollectionWidth = 64;
 // more for four shapes (docs/collections.md, ninth round).
 constexpr int kCollectionDeformLayers = 3;
 // ... and a template start of at most this many steps (FitOptions::
-// template_max_steps): PROVISIONAL, measured in docs/collections.md, tenth round.
+// template_max_steps). At the same 3000 joint steps (one thread, seed 1), a
+// template of 22000 steps against 9000 carries the ants worse (chart rule
+// 7.84 against 5.68) and fits both categories worse (ant Chamfer 1.40-1.56x
+// against 1.15-1.21x the floor); 9000 is what ten minutes of two cores gave
+// the template here (docs/collections.md, tenth round).
 constexpr int64_t kTemplateMaxSteps = 9000;
 
 // `--preset paper`: the paper's method at the paper's sizes (Sec. 3,
