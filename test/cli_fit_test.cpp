@@ -286,9 +286,10 @@ TEST_CASE("cli: the schedule's flags are saved, collections keep M fixed, a shor
   REQUIRE(r.code == 0);
   CHECK(settings(dir + "_budget")["iterations"] > 25);
   // Under --minutes the template start takes its share of the time, but no
-  // more than --template-max-steps; the joint training gets the rest.
+  // more than --template-max-steps; the joint training gets the rest. (1.8 s
+  // of template time for 40 steps of these tiny networks: a wide margin.)
   r = run("fit builtin:sphere builtin:torus -o " + dir +
-          "_capped --minutes 0.05 --no-align --template-shape 0 --template-max-steps 40" + kSmall);
+          "_capped --minutes 0.1 --no-align --template-shape 0 --template-max-steps 40" + kSmall);
   INFO(r.output);
   REQUIRE(r.code == 0);
   CHECK(settings(dir + "_capped")["template_steps"] == 40);
