@@ -2,6 +2,7 @@
 // grain-sized ranges, whatever n is relative to the grain.
 #include <omp.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cstdlib>
 #include <limits>
@@ -22,13 +23,40 @@ TEST_CASE("parallel_rows covers every row exactly once", "[parallel]") {
   }
 }
 
-TEST_CASE("parallel_rows hands out ranges of at most grain rows", "[parallel]") {
-  const Index n = 1000, grain = 64;
-  std::vector<Index> sizes(size_t((n + grain - 1) / grain), -1);
-  parallel_rows(
-      n, [&](Index r0, Index r1) { sizes[size_t(r0 / grain)] = r1 - r0; }, grain);
-  for (size_t c = 0; c + 1 < sizes.size(); ++c) CHECK(sizes[c] == grain);
-  CHECK(sizes.back() == n % grain);
+TEST_CASE("parallel_rows hands out balanced ranges of at most grain rows", "[parallel]") {
+  const Index grain = 64;
+  for (Index n : {Index(65), Index(100), Index(1000), Index(4097)}) {
+    std::vector<Index> sizes(size_t(n), 0);  // indexed by a range's first row
+    parallel_rows(
+        n, [&](Index r0, Index r1) { sizes[size_t(r0)] = r1 - r0; }, grain);
+    Index lo = n, hi = 0, count = 0, covered = 0;
+    for (Index s : sizes)
+      if (s > 0) {
+        lo = std::min(lo, s);
+        hi = std::max(hi, s);
+        ++count;
+        covered += s;
+      }
+    INFO("n = " << n << ", " << count << " ranges of " << lo << ".." << hi << " rows");
+    CHECK(covered == n);
+    CHECK(hi <= grain);
+    CHECK(hi - lo <= 1);                   // equal to a row: no thread waits on a short chunk
+    CHECK(count % max_threads() == 0);     // and every thread gets as many chunks
+    CHECK(count <= (n + grain - 1) / grain + max_threads() - 1);
+  }
+}
+
+TEST_CASE("parallel_rows balances two threads on a block just past the grain", "[parallel]") {
+  // 5000 rows with the default grain: three chunks of 2048, 2048 and 904 rows
+  // put 4096 rows on one of two threads; balanced, each thread gets 2500.
+  const int before = omp_get_max_threads();
+  omp_set_num_threads(2);
+  REQUIRE(max_threads() == 2);
+  std::vector<Index> rows_of(2, 0);  // each thread adds to its own entry
+  parallel_rows(5000, [&](Index r0, Index r1) { rows_of[size_t(omp_get_thread_num())] += r1 - r0; });
+  omp_set_num_threads(before);
+  CHECK(rows_of[0] == 2500);
+  CHECK(rows_of[1] == 2500);
 }
 
 TEST_CASE("set_threads(0) keeps the thread count", "[parallel]") {

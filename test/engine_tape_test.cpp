@@ -10,8 +10,12 @@ namespace jsa {
 namespace {
 
 // A small graph with a fixed shape, as one training step would build.
+// x is node 0 and w node 1: made in two statements, since the order in which
+// a call's arguments are evaluated is unspecified (GCC goes right to left).
 Var build(Tape<double>& t, const Block<double>& x, const Block<double>& w) {
-  Var h = relu(t, linear(t, t.constant(x), t.variable(w), Var{}));
+  const Var xv = t.constant(x);
+  const Var wv = t.variable(w);
+  Var h = relu(t, linear(t, xv, wv, Var{}));
   return mean(t, square(t, h));
 }
 
