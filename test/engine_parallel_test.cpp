@@ -40,8 +40,8 @@ TEST_CASE("parallel_rows hands out balanced ranges of at most grain rows", "[par
     INFO("n = " << n << ", " << count << " ranges of " << lo << ".." << hi << " rows");
     CHECK(covered == n);
     CHECK(hi <= grain);
-    CHECK(hi - lo <= 1);                   // equal to a row: no thread waits on a short chunk
-    CHECK(count % max_threads() == 0);     // and every thread gets as many chunks
+    CHECK(hi - lo <= 1);                // equal to a row: no thread waits on a short chunk
+    CHECK(count % max_threads() == 0);  // and every thread gets as many chunks
     CHECK(count <= (n + grain - 1) / grain + max_threads() - 1);
   }
 }
@@ -53,7 +53,8 @@ TEST_CASE("parallel_rows balances two threads on a block just past the grain", "
   omp_set_num_threads(2);
   REQUIRE(max_threads() == 2);
   std::vector<Index> rows_of(2, 0);  // each thread adds to its own entry
-  parallel_rows(5000, [&](Index r0, Index r1) { rows_of[size_t(omp_get_thread_num())] += r1 - r0; });
+  parallel_rows(5000,
+                [&](Index r0, Index r1) { rows_of[size_t(omp_get_thread_num())] += r1 - r0; });
   omp_set_num_threads(before);
   CHECK(rows_of[0] == 2500);
   CHECK(rows_of[1] == 2500);
