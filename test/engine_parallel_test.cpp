@@ -1,5 +1,5 @@
 // Tests of engine/parallel.h: parallel_rows covers [0, n) exactly once in
-// grain-sized ranges, whatever n is relative to the grain.
+// equal ranges of at most grain rows, as many per thread, whatever n is.
 #include <omp.h>
 
 #include <algorithm>
