@@ -1,7 +1,9 @@
-// Plots the CSV that bench/quality_vs_time.sh writes: each fit's Chamfer and
-// unit-normal error as ratios to their sampling floors, against its wall time,
-// one line per schedule and shape (the mean over the seeds at each budget).
-//   bench_quality_plot RESULTS.csv OUT_PREFIX   -> OUT_PREFIX_chamfer.png, OUT_PREFIX_normals.png
+// Plots the CSV that bench/quality_vs_time.sh writes: each fit's Chamfer,
+// unit-normal error and EMD as ratios to their sampling floors, against its
+// wall time, one line per schedule and shape (the mean over the seeds at each
+// budget). Several runs' CSVs may be concatenated (repeated headers are skipped).
+//   bench_quality_plot RESULTS.csv OUT_PREFIX
+//     -> OUT_PREFIX_chamfer.png, OUT_PREFIX_normals.png, OUT_PREFIX_emd.png
 #include <cstdio>
 #include <exception>
 #include <fstream>
@@ -16,7 +18,7 @@
 namespace {
 
 struct Point {
-  double seconds = 0, chamfer = 0, normals = 0;
+  double seconds = 0, chamfer = 0, normals = 0, emd = 0;
   int count = 0;
 };
 
@@ -43,29 +45,31 @@ int main(int argc, char** argv) try {
     std::stringstream s(line);
     std::string cell;
     while (std::getline(s, cell, ',')) cells.push_back(cell);
-    if (cells.size() < 9) continue;
+    if (cells.size() < 9 || cells[0] == "schedule") continue;
     try {
       Point& p = lines[cells[0] + " " + cells[1]][std::stod(cells[3])];
       p.seconds += std::stod(cells[4]);
       p.chamfer += std::stod(cells[6]);
       p.normals += std::stod(cells[7]);
+      p.emd += std::stod(cells[8]);
       ++p.count;
     } catch (const std::exception&) {
       std::fprintf(stderr, "%s:%d: not a number where one is expected\n", argv[1], row);
       return 1;
     }
   }
-  std::vector<jsa::Series> chamfer, normals;
+  std::vector<jsa::Series> chamfer, normals, emd;
   for (const auto& [name, budgets] : lines) {
-    jsa::Series c{name, {}, {}}, n{name, {}, {}};
+    jsa::Series c{name, {}, {}}, n{name, {}, {}}, e{name, {}, {}};
     for (const auto& [minutes, p] : budgets) {
-      c.x.push_back(p.seconds / p.count);
+      for (jsa::Series* s : {&c, &n, &e}) s->x.push_back(p.seconds / p.count);
       c.y.push_back(p.chamfer / p.count);
-      n.x.push_back(p.seconds / p.count);
       n.y.push_back(p.normals / p.count);
+      e.y.push_back(p.emd / p.count);
     }
     chamfer.push_back(c);
     normals.push_back(n);
+    emd.push_back(e);
   }
   jsa::PlotOptions o;
   o.log_x = true;
@@ -77,6 +81,8 @@ int main(int argc, char** argv) try {
   jsa::write_png(prefix + "_chamfer.png", jsa::line_plot(chamfer, o));
   o.title = "unit-normal distance / sampling floor";
   jsa::write_png(prefix + "_normals.png", jsa::line_plot(normals, o));
+  o.title = "EMD (samples through P and phi) / sampling floor";
+  jsa::write_png(prefix + "_emd.png", jsa::line_plot(emd, o));
   return 0;
 } catch (const std::exception& e) {  // an unwritable output, a plot without data
   std::fprintf(stderr, "bench_quality_plot: %s\n", e.what());

@@ -8,7 +8,7 @@
 # the default and the previous one), SEEDS (default "1"), JOBS (fits at a time,
 # default 1; with JOBS > 1 give --threads 1 among the extra flags).
 # Writes OUT_DIR/quality.csv, OUT_DIR/quality.md (a table per shape) and, when
-# bench_quality_plot is built, OUT_DIR/quality_chamfer.png and quality_normals.png.
+# bench_quality_plot is built, OUT_DIR/quality_chamfer.png, quality_normals.png and quality_emd.png.
 set -euo pipefail
 out="$1"; shift
 meshes=()

@@ -911,6 +911,9 @@ void add_fit(CLI::App& app) {
                     std::to_string(kCollectionDeformLayers) + ")")
       ->capture_default_str()
       ->check(CLI::Range(0, 64));
+  c->add_flag("--deform-domain", o.atlas.deform_domain,
+              "Collections, with --deform-layers > 0: D also reads the domain point, "
+              "phi_i(x) = phi(x) + D(phi(x), x, f_i)");
   c->add_option("--reseed", o.reseed_every,
                 "Every N steps before the first decay, move the Gaussians of back-facing flaps to "
                 "the surface's holes (0: never, as the paper; see model/heuristics/reseed.h)")

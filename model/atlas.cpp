@@ -15,7 +15,8 @@ Atlas<T>::Atlas(const AtlasOptions& o) : options_(o) {
   if (d > 0 && o.deform_layers > 0)
     phi = Parametrization<T>(
         params, MlpShape{2, 3, o.width, o.hidden_layers, 0, 0, o.softplus_beta}, T(o.alpha),
-        MlpShape{3, 3, o.width, o.deform_layers, d, o.code_layer, o.softplus_beta});
+        MlpShape{o.deform_domain ? 5 : 3, 3, o.width, o.deform_layers, d, o.code_layer,
+                 o.softplus_beta});
   else
     phi = Parametrization<T>(
         params, MlpShape{2, 3, o.width, o.hidden_layers, d, o.code_layer, o.softplus_beta},

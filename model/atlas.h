@@ -27,6 +27,10 @@ struct AtlasOptions {
   // layers taking the code; phi itself then takes none (model/parametrize.h).
   // 0: the paper's phi(x, f_phi,i).
   int deform_layers = 0;
+  // With deform_layers: D also reads the domain point, D(phi(x), x, f_phi,i), so
+  // two sheets that touch in 3D (an arm folded on a chest) can move apart; a
+  // function of the 3D point alone must move them together. false: D(phi(x), f).
+  bool deform_domain = false;
 };
 
 template <class T>

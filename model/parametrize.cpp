@@ -9,20 +9,24 @@ template <class T>
 SurfacePoints Parametrization<T>::evaluate(Tape<T>& t, Parameters<T>& params, Var x,
                                            bool with_jacobian, Var code) const {
   SurfacePoints s;
-  // phi_i(x) = p + D(p, f_i), p = phi(x), when phi deforms one surface per shape.
-  auto deformed = [&](Var p, Index value_rows) {
-    return add(t, p, deform_.forward(t, params, p, value_rows, code));
+  // phi_i(x) = p + D(p, f_i), p = phi(x), when phi deforms one surface per shape
+  // (D(p, x, f_i) when D also reads the domain point: x holds its rows' x).
+  const bool reads_domain = deforms_ && deform_.shape().in == 5;
+  auto deformed = [&](Var p, Var x_rows, Index value_rows) {
+    const Var in = reads_domain ? concat_cols(t, {p, x_rows}) : p;
+    return add(t, p, deform_.forward(t, params, in, value_rows, code));
   };
   const Var phi_code = deforms_ ? Var{} : code;
   if (!with_jacobian) {
     s.points = mlp_.forward(t, params, x, -1, phi_code);
-    if (deforms_) s.points = deformed(s.points, -1);
+    if (deforms_) s.points = deformed(s.points, x, -1);
     return s;
   }
   // [x; e_u; e_v] -> [phi(x); J_u; J_v]: one pass, 3M rows (Eq. 1).
   const Index m = t.rows(x);
-  Var y3 = mlp_.forward(t, params, stack_tangents(t, x), m, phi_code);
-  if (deforms_) y3 = deformed(y3, m);  // [p + D; (I + dD/dp) J_u; (I + dD/dp) J_v]
+  const Var x3 = stack_tangents(t, x);
+  Var y3 = mlp_.forward(t, params, x3, m, phi_code);
+  if (deforms_) y3 = deformed(y3, x3, m);  // [p + D; (I + dD/dp) J_u (+ dD/du); ...]
   Stacked y = unstack(t, y3);
   s.points = y.value;
   s.du = y.du;

@@ -35,11 +35,17 @@ class Parametrization {
   // domain and differ by a deformation that moves neighbours together; the
   // tangents follow by the chain rule, J_i = (I + dD/dp) J, since D runs on
   // the stacked rows [p; J_u; J_v] like any layer (engine/tangents.h).
+  // deform.in = 5: D(p, x, f_i) also reads the domain point; its stacked rows
+  // are [p, x; J_u, e_u; J_v, e_v], so J_i = (I + dD/dp) J + dD/dx still holds
+  // row by row.
   Parametrization(Parameters<T>& params, const MlpShape& shape, T alpha, const MlpShape& deform)
       : mlp_(params, "phi", shape),
         deform_(params, "phi.deform", deform),
         alpha_(alpha),
-        deforms_(true) {}
+        deforms_(true) {
+    JSA_CHECK(deform.in == 3 || deform.in == 5,
+              "D reads the 3D point, or the 3D point and the domain point: in = 3 or 5");
+  }
   // MLPs as PyTorch's default; D's output layer then scaled by 1e-2, so every
   // shape starts as phi's surface, nearly undeformed.
   void initialize(Parameters<T>& params, Rng& rng) const {

@@ -401,13 +401,16 @@ TEST_CASE("objective: L_metric is 0 for equal codes, and its gradient matches ce
 
 TEST_CASE("objective: phi as a deformation per shape (deform_layers): gradients and Jacobians",
           "[objective]") {
-  // phi_i(x) = p + D(p, f_i), p = phi(x): every parameter of phi, of D and the
-  // codes gets its gradient through the stacked rows, and the Jacobian those
-  // rows carry is the derivative of phi_i (central differences in u and v).
+  // phi_i(x) = p + D(p, f_i), p = phi(x), and with deform_domain
+  // phi_i(x) = p + D(p, x, f_i): every parameter of phi, of D and the codes gets
+  // its gradient through the stacked rows, and the Jacobian those rows carry is
+  // the derivative of phi_i (central differences in u and v).
   AtlasOptions ao = small_atlas_options();
   ao.shapes = 2;
   ao.code_size = 4;
   ao.deform_layers = 2;
+  ao.deform_domain = GENERATE(false, true);
+  INFO("deform_domain " << ao.deform_domain);
   ao.softplus_beta = 10;  // smooth, so the differences in x cross no kink
   Atlas<double> atlas(ao);
   Rng init(5);

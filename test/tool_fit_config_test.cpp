@@ -178,6 +178,15 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   std::string negative = jsa::fit_options_to_json(d, -1);
   negative.replace(negative.find(",\"deform_layers\":3"), 18, ",\"deform_layers\":-1");
   CHECK_THROWS(jsa::fit_options_from_json(negative, "negative"));
+  // D reading the domain point: kept when set, off when absent.
+  d.atlas.deform_domain = true;
+  CHECK(jsa::fit_options_from_json(jsa::fit_options_to_json(d), "x").atlas.deform_domain);
+  std::string before_domain = jsa::fit_options_to_json(d, -1);
+  const std::string domain_key = ",\"deform_domain\":true";
+  const auto domain_at = before_domain.find(domain_key);
+  REQUIRE(domain_at != std::string::npos);
+  before_domain.erase(domain_at, domain_key.size());
+  CHECK(!jsa::fit_options_from_json(before_domain, "old").atlas.deform_domain);
 }
 
 TEST_CASE("fit config: malformed JSON is rejected naming the source and the field",

@@ -50,7 +50,8 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
                 {"code_size", o.atlas.code_size},
                 {"code_layer", o.atlas.code_layer},
                 {"softplus_beta", o.atlas.softplus_beta},
-                {"deform_layers", o.atlas.deform_layers}};
+                {"deform_layers", o.atlas.deform_layers},
+                {"deform_domain", o.atlas.deform_domain}};
   j["weights"] = {{"surface_6d", o.weights.surface},
                   {"chart_2d", o.weights.chart},
                   {"cycle", o.weights.cycle},
@@ -135,6 +136,8 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (a.contains("deform_layers")) field(a, "atlas.", "deform_layers", o.atlas.deform_layers);
   if (o.atlas.deform_layers < 0 || o.atlas.deform_layers > 64)
     throw InputError(what + ": atlas.deform_layers must be in [0, 64]");
+  o.atlas.deform_domain = false;  // later addition: absent = D(phi(x), f)
+  if (a.contains("deform_domain")) field(a, "atlas.", "deform_domain", o.atlas.deform_domain);
   const json& w = j.contains("weights") ? j["weights"] : json();
   field(w, "weights.", "surface_6d", o.weights.surface);
   field(w, "weights.", "chart_2d", o.weights.chart);
