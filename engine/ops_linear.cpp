@@ -60,15 +60,22 @@ Var relu_masked(Tape<T>& t, Var x, Index m) {
       Y.middleRows(k * m + r0, r1 - r0) = (X.middleRows(r0, r1 - r0).array() > T(0))
                                               .select(X.middleRows(k * m + r0, r1 - r0), T(0));
   });
-  // dx_k += [z > 0] * dy_k   (the mask itself is piecewise constant: no gradient)
+  // dx_k += [z > 0] * dy_k   (the mask itself is piecewise constant: no gradient;
+  // every entry is written, so a first writer assigns: Tape::grad_to_overwrite)
   t.on_backward(y, [x, m, blocks](Tape<T>& t, Var y) {
     const Block<T>& X = t.value(x);
     const Block<T>& dY = t.grad(y);
-    Block<T>& dX = t.grad(x);
+    bool first = false;
+    Block<T>& dX = t.grad_to_overwrite(x, &first);
     parallel_rows(m, [&](Index r0, Index r1) {
-      for (Index k = 0; k < blocks; ++k)
-        dX.middleRows(k * m + r0, r1 - r0) += (X.middleRows(r0, r1 - r0).array() > T(0))
-                                                  .select(dY.middleRows(k * m + r0, r1 - r0), T(0));
+      for (Index k = 0; k < blocks; ++k) {
+        auto masked = (X.middleRows(r0, r1 - r0).array() > T(0))
+                          .select(dY.middleRows(k * m + r0, r1 - r0), T(0));
+        if (first)
+          dX.middleRows(k * m + r0, r1 - r0) = masked;
+        else
+          dX.middleRows(k * m + r0, r1 - r0) += masked;
+      }
     });
   });
   return y;
@@ -116,10 +123,13 @@ Var softplus_stacked(Tape<T>& t, Var x, Index m, T beta) {
       for (Index k = 1; k < blocks; ++k) Y.row(k * m + i).array() = s1 * X.row(k * m + i).array();
     }
   });
+  // Every entry of dX is written, so when this is its first writer (an MLP's
+  // pre-activation has no other consumer) it is assigned, not zeroed and added to.
   t.on_backward(y, [x, m, blocks, beta, c](Tape<T>& t, Var y) {
     const Block<T>& X = t.value(x);
     const Block<T>& dY = t.grad(y);
-    Block<T>& dX = t.grad(x);
+    bool first = false;
+    Block<T>& dX = t.grad_to_overwrite(x, &first);
     parallel_rows(m, [&](Index r0, Index r1) {
       RowArray<T> bz(c), e(c), s1(c), s2(c), dz(c);
       for (Index i = r0; i < r1; ++i) {
@@ -131,10 +141,16 @@ Var softplus_stacked(Tape<T>& t, Var x, Index m, T beta) {
           s2 = beta * s1 * (T(1) - s1);
           for (Index k = 1; k < blocks; ++k) {
             dz += dY.row(k * m + i).array() * X.row(k * m + i).array() * s2;
-            dX.row(k * m + i).array() += dY.row(k * m + i).array() * s1;
+            if (first)
+              dX.row(k * m + i).array() = dY.row(k * m + i).array() * s1;
+            else
+              dX.row(k * m + i).array() += dY.row(k * m + i).array() * s1;
           }
         }
-        dX.row(i).array() += dz;
+        if (first)
+          dX.row(i).array() = dz;
+        else
+          dX.row(i).array() += dz;
       }
     });
   });

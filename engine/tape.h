@@ -19,7 +19,11 @@
 // per node (about half of a training step's memory). Leaves (no pull-back)
 // keep theirs until the next backward() or clear(), for the caller to read.
 // A node nobody wrote a gradient into has a zero gradient: its pull-back is
-// skipped, since pull-backs are linear in it.
+// skipped, since pull-backs are linear in it. Zeroing a lent block is a pass
+// over memory as large as the block (an MLP layer's 3M x width rows), so it is
+// spread over the threads, and a pull-back that writes every entry of an
+// input's gradient asks for it with grad_to_overwrite() and skips the zeroing
+// when it is the first writer.
 //
 // There is no global tape: every op takes the tape it writes to.
 #pragma once
@@ -29,6 +33,7 @@
 
 #include "engine/block.h"
 #include "engine/check.h"
+#include "engine/parallel.h"
 
 namespace jsa {
 
@@ -80,6 +85,21 @@ class Tape {
                 "the gradient of node " << v.id << " is not kept: only leaves' gradients "
                                         << "outlive backward()");
       lend(n);
+    }
+    return n.grad;
+  }
+  // For a pull-back that writes every entry of grad(v): *first is true when no
+  // pull-back has written into it yet, and the block's entries are then
+  // unspecified (the caller assigns, =); otherwise it holds the sum so far
+  // (the caller accumulates, +=).
+  Block<T>& grad_to_overwrite(Var v, bool* first) {
+    Node& n = nodes_[check(v)];
+    *first = !n.grad_live;
+    if (*first) {
+      JSA_CHECK(sweeping_ && !n.grad_returned,
+                "the gradient of node " << v.id << " is not kept: only leaves' gradients "
+                                        << "outlive backward()");
+      lend(n, /*zero=*/false);
     }
     return n.grad;
   }
@@ -171,7 +191,7 @@ class Tape {
   // same sizes in the same order every step, so after the first step no block
   // is allocated; when the sizes change (a schedule's M) the old blocks are
   // resized rather than kept.
-  void lend(Node& n) {
+  void lend(Node& n, bool zero = true) {
     const Index rows = n.value.rows(), cols = n.value.cols();
     size_t pick = pool_.size();
     for (size_t k = pool_.size(); k-- > 0;)
@@ -185,7 +205,9 @@ class Tape {
       pool_[pick].swap(pool_.back());
       pool_.pop_back();
     }
-    n.grad.setZero(rows, cols);
+    n.grad.resize(rows, cols);
+    if (zero)
+      parallel_rows(rows, [&](Index r0, Index r1) { n.grad.middleRows(r0, r1 - r0).setZero(); });
     n.grad_live = true;
   }
   void give_back(Node& n) {
