@@ -99,6 +99,7 @@ auto with_flag_names(F&& f) {
       {"template_shape", "--template-shape"},
       {"chart_from", "--chart-from"},
       {"code_lr_scale", "--code-lr-scale"},
+      {"surface_lr_scale", "--surface-lr-scale"},
       {"schedule.kind", "--schedule"},
       {"schedule.points_start", "--points-start"},
       {"schedule.ramp_until", "--ramp-until"},
@@ -936,6 +937,13 @@ void add_fit(CLI::App& app) {
                 "Collections: learning rate of the latent codes as a multiple of the networks'")
       ->capture_default_str()
       ->check(CLI::Range(1e-3, 1e3))
+      ->check(kFinite);
+  c->add_option("--surface-lr-scale", o.surface_lr_scale,
+                "Collections with --deform-layers > 0: learning rate of the shared surface phi "
+                "in the joint training as a multiple of the rest's (0: the template's surface "
+                "stays fixed, every shape a deformation of it)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e3))
       ->check(kFinite);
   c->add_option("--chart-from", o.chart_from,
                 "Staged objective: phi and P alone (no psi, L_2D, L_cycle) until this fraction of "

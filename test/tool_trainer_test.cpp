@@ -414,6 +414,42 @@ TEST_CASE("trainer: code_lr_scale scales the codes' Adam step and nothing else",
   CHECK(a.atlas().params.values()[e.offset] == b.atlas().params.values()[e.offset]);
 }
 
+TEST_CASE(
+    "trainer: surface_lr_scale scales the shared surface's joint steps, not D's or the template's",
+    "[trainer]") {
+  // A deformed collection: phi.* is the shared surface, phi.deform.* is D.
+  FitOptions o = small_options();
+  o.threads = 1;
+  o.iterations = 10;
+  o.atlas.deform_layers = 2;
+  FitOptions frozen = o, half = o;
+  frozen.surface_lr_scale = 0;
+  half.surface_lr_scale = 0.5;
+  Trainer a(o, two_spheres()), z(frozen, two_spheres()), h(half, two_spheres());
+  auto entry = [&](Trainer& t, const char* name) { return code_row(t, name, 0); };
+  // The template start trains the surface at the full rate under every scale.
+  a.train_template(3);
+  z.train_template(3);
+  h.train_template(3);
+  REQUIRE(entry(z, "phi.w1") == entry(a, "phi.w1"));
+  const std::vector<float> surface = entry(a, "phi.w1"), deform = entry(a, "phi.deform.w0");
+  a.step();
+  z.step();
+  h.step();
+  CHECK(a.last().total == z.last().total);  // the same state and draws before the step
+  CHECK(entry(z, "phi.w1") == surface);     // frozen
+  CHECK(entry(z, "phi.deform.w0") == entry(a, "phi.deform.w0"));  // D at the full rate
+  const std::vector<float> moved = entry(a, "phi.w1"), halved = entry(h, "phi.w1");
+  double total = 0;
+  for (size_t k = 0; k < surface.size(); ++k) {
+    total += std::abs(moved[k] - surface[k]);
+    REQUIRE(double(halved[k] - surface[k]) ==
+            Approx(0.5 * double(moved[k] - surface[k])).margin(1e-7));
+  }
+  CHECK(total > 0);
+  CHECK(entry(a, "phi.deform.w0") != deform);
+}
+
 TEST_CASE("trainer: chart_from trains phi and P alone until that fraction of the run",
           "[trainer]") {
   FitOptions o = small_options();

@@ -95,6 +95,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["metric_end"] = o.metric_end;
   j["metric_conformal"] = o.metric_conformal;
   j["code_lr_scale"] = o.code_lr_scale;
+  j["surface_lr_scale"] = o.surface_lr_scale;
   j["parallel_shapes"] = o.parallel_shapes;
   j["pool"] = o.pool;
   j["threads"] = o.threads;
@@ -208,6 +209,10 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (j.contains("code_lr_scale")) field(j, "", "code_lr_scale", o.code_lr_scale);
   if (!(o.code_lr_scale > 0) || !std::isfinite(o.code_lr_scale))
     throw InputError(what + ": code_lr_scale must be positive");
+  o.surface_lr_scale = 1;  // later addition: absent = one rate
+  if (j.contains("surface_lr_scale")) field(j, "", "surface_lr_scale", o.surface_lr_scale);
+  if (!(o.surface_lr_scale >= 0) || !std::isfinite(o.surface_lr_scale))
+    throw InputError(what + ": surface_lr_scale must be >= 0");
   o.parallel_shapes = false;  // later addition: runs before it took one shape at a time
   if (j.contains("parallel_shapes")) field(j, "", "parallel_shapes", o.parallel_shapes);
   o.metric_end = -1;  // later addition: absent = a constant lambda_metric

@@ -51,6 +51,8 @@ static void validate(const FitOptions& o) {
   require(std::isfinite(o.metric_end), "metric_end must be finite (< 0: lambda_metric constant)");
   require(o.code_lr_scale > 0 && std::isfinite(o.code_lr_scale),
           "code_lr_scale must be positive and finite");
+  require(o.surface_lr_scale >= 0 && std::isfinite(o.surface_lr_scale),
+          "surface_lr_scale must be >= 0 and finite");
   const ScheduleOptions& s = o.schedule;
   require(s.kind == "ramp" || s.kind == "step", "schedule.kind must be ramp or step");
   require(s.points_start > 0 && s.points_start <= 1, "schedule.points_start must be in (0, 1]");
@@ -463,22 +465,34 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
   }
   if (position > failed_position_) unresolved_faults_ = 0;  // past every failure so far
   if (counter % kSnapshotEvery == 0) take_snapshot(rng_at_start);
-  if (options_.code_lr_scale != 1 && atlas_->has_codes()) {
-    // Adam's update of the codes, scaled: theta <- old + s (theta_Adam - old).
-    std::vector<std::pair<size_t, std::vector<float>>> before;
-    for (const char* name : {"codes.phi", "codes.psi"}) {
-      const auto& e = atlas_->params.entry(atlas_->params.find(name));
-      const float* v = atlas_->params.values().data() + e.offset;
-      before.emplace_back(size_t(e.offset), std::vector<float>(v, v + e.rows * e.cols));
+  // Per-group rates: Adam's update of a group, scaled by s,
+  // theta <- old + s (theta_Adam - old): the codes (code_lr_scale) and, in the
+  // joint training of a deformed collection, the shared surface phi
+  // (surface_lr_scale; its parameters are "phi.*" but not D's "phi.deform.*").
+  struct Held {
+    size_t offset;
+    float scale;
+    std::vector<float> old;
+  };
+  std::vector<Held> held;
+  auto hold = [&](int index, double scale) {
+    const auto& e = atlas_->params.entry(index);
+    const float* v = atlas_->params.values().data() + e.offset;
+    held.push_back({size_t(e.offset), float(scale), std::vector<float>(v, v + e.rows * e.cols)});
+  };
+  if (options_.code_lr_scale != 1 && atlas_->has_codes())
+    for (const char* name : {"codes.phi", "codes.psi"})
+      hold(atlas_->params.find(name), options_.code_lr_scale);
+  if (options_.surface_lr_scale != 1 && !template_step && atlas_->phi.deforms())
+    for (int i = 0; i < atlas_->params.count(); ++i) {
+      const std::string& name = atlas_->params.entry(i).name;
+      if (name.rfind("phi.", 0) == 0 && name.rfind("phi.deform.", 0) != 0)
+        hold(i, options_.surface_lr_scale);
     }
-    adam_.step(atlas_->params, lr);
-    const float s = float(options_.code_lr_scale);
-    for (const auto& [offset, old] : before) {
-      float* v = atlas_->params.values().data() + offset;
-      for (size_t k = 0; k < old.size(); ++k) v[k] = old[k] + s * (v[k] - old[k]);
-    }
-  } else {
-    adam_.step(atlas_->params, lr);
+  adam_.step(atlas_->params, lr);
+  for (const Held& h : held) {
+    float* v = atlas_->params.values().data() + h.offset;
+    for (size_t k = 0; k < h.old.size(); ++k) v[k] = h.old[k] + h.scale * (v[k] - h.old[k]);
   }
   batch_step_ = batch;
   return true;

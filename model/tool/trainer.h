@@ -112,6 +112,11 @@ struct FitOptions {
   // Collections: the latent codes' learning rate as a multiple of the networks'
   // (a per-group rate: the codes' Adam steps are scaled by it). 1: one rate.
   double code_lr_scale = 1;
+  // Collections with deform_layers: the shared surface phi's (not D's)
+  // learning rate in the joint training, as a multiple of the rest's. 0 keeps
+  // the template's surface and layout fixed once the template start is done,
+  // so every shape is a deformation of one fixed surface; 1: one rate.
+  double surface_lr_scale = 1;
   // Collections: lambda_metric moves from weights.metric at the first joint
   // step to this value at the first learning-rate decay (geometrically;
   // model/tool/schedule.h, scheduled_weight), then stays. < 0: constant.
