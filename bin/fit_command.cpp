@@ -238,6 +238,9 @@ void run_fit(FitArgs& a, Team& team) {
       if (!a.width_given) o.atlas.width = kCollectionWidth;
       if (!a.deform_given) o.atlas.deform_layers = kCollectionDeformLayers;
     }
+    if (o.atlas.deform_domain && (inputs.size() < 2 || o.atlas.deform_layers == 0))
+      throw InputError(
+          "--deform-domain: needs a collection (two or more inputs) with --deform-layers > 0");
   }
   if (a.threads >= 0) o.threads = a.threads;
   set_threads(o.threads);

@@ -103,4 +103,7 @@ TEST_CASE("cli: flag values out of range are refused before any work", "[cli]") 
   rejects(fit + "--pool 10", 2, "--pool: Value 10 not in range 100 to 10000000");
   rejects(fit + "--w-iso -1", 2, "--w-iso");
   rejects(fit + "--alpha inf", 2, "--alpha");
+  rejects(fit + "--surface-lr-scale -1", 2, "--surface-lr-scale");
+  // D reading the domain point exists only in a deformed collection.
+  rejects(fit + "--deform-domain", 1, "--deform-domain: needs a collection");
 }
