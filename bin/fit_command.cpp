@@ -23,6 +23,7 @@
 #include "bin/run_files.h"
 #include "engine/parallel.h"
 #include "io/atomic_write.h"
+#include "io/geometry/intrinsic_descriptors.h"
 #include "io/pictures/image.h"
 #include "model/tool/checkpoint.h"
 #include "model/tool/fit_config.h"
@@ -100,6 +101,7 @@ auto with_flag_names(F&& f) {
       {"chart_from", "--chart-from"},
       {"code_lr_scale", "--code-lr-scale"},
       {"surface_lr_scale", "--surface-lr-scale"},
+      {"intrinsic", "--intrinsic"},
       {"schedule.kind", "--schedule"},
       {"schedule.points_start", "--points-start"},
       {"schedule.ramp_until", "--ramp-until"},
@@ -238,6 +240,8 @@ void run_fit(FitArgs& a, Team& team) {
       if (!a.width_given) o.atlas.width = kCollectionWidth;
       if (!a.deform_given) o.atlas.deform_layers = kCollectionDeformLayers;
     }
+    if (o.intrinsic > 0 && inputs.size() < 2)
+      throw InputError("--intrinsic: needs a collection (two or more inputs)");
     if (o.atlas.deform_domain && (inputs.size() < 2 || o.atlas.deform_layers == 0))
       throw InputError(
           "--deform-domain: needs a collection (two or more inputs) with --deform-layers > 0");
@@ -339,6 +343,21 @@ void run_fit(FitArgs& a, Team& team) {
   for (size_t i = 0; i < inputs.size(); ++i) {
     const bool mine = int(i) >= block_first && int(i) < block_last;
     if (mine) pools[i] = shapes[i].pool;
+    if (mine && o.intrinsic > 0) {
+      // L_6D^h (model/objective.h): h at every pool sample, from the mesh's
+      // vertices (in the pool's frame: to_unit turns them as the pool was turned).
+      const IntrinsicDescriptors h = intrinsic_descriptors(shapes[i].mesh);
+      const Block<double> at = descriptors_at(
+          shapes[i].pool.leftCols(3), shapes[i].normalization.to_unit(h.nodes), h.values);
+      pools[i].conservativeResize(Eigen::NoChange, 9);
+      pools[i].rightCols(3) = at;
+      if (!a.quiet)
+        std::fprintf(stderr,
+                     "fit: shape %zu: intrinsic descriptors on %lld nodes, mean geodesic "
+                     "distance %.3f to %.3f\n",
+                     i, static_cast<long long>(h.nodes.rows()), h.values.col(0).minCoeff(),
+                     h.values.col(0).maxCoeff());
+    }
     frames[i] = shapes[i].normalization;
     shapes[i].pool.resize(0, 6);                 // the trainer keeps its own copy
     if (!mine && !root) shapes[i] = RunInput{};  // shape 0, read for the pose step only
@@ -945,6 +964,13 @@ void add_fit(CLI::App& app) {
                 "Collections with --deform-layers > 0: learning rate of the shared surface phi "
                 "in the joint training as a multiple of the rest's (0: the template's surface "
                 "stays fixed, every shape a deformation of it)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e3))
+      ->check(kFinite);
+  c->add_option("--intrinsic", o.intrinsic,
+                "Collections: beta, the weight of pose-invariant descriptors (geodesic distance "
+                "statistics) appended to L_6D, so each domain point lands where the shapes agree "
+                "along their surfaces (0: off)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1e3))
       ->check(kFinite);

@@ -25,17 +25,20 @@ Components Components::table_row(int row) {
 template <class T>
 Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T>& targets, Index m,
                            Rng& rng, const ObjectiveOptions& o, LossTerms* terms,
-                           const NearestIndex<T>* dense) {
+                           const NearestIndex<T>* dense, const IntrinsicField<T>* intrinsic) {
   const LossWeights& w = o.weights;
   const Components& c = o.components;
-  JSA_CHECK(targets.cols() == 6, "targets must be M x 6 [x_S, alpha n_S]");
+  JSA_CHECK(targets.cols() == (intrinsic ? 9 : 6),
+            (intrinsic ? "targets must be M x 9 [x_S, alpha n_S, beta h_S]"
+                       : "targets must be M x 6 [x_S, alpha n_S]"));
+  JSA_CHECK(!intrinsic || c.normals, "L_6D^h needs the normals in the loss");
   Parameters<T>& p = atlas.params;
   LossTerms out;
   std::vector<std::pair<double, Var>> weighted;  // (lambda, term)
 
   // {x_P} ~ P by the reparameterization trick (Eq. 4).
   const Var x_p = atlas.domain.sample(t, p, m, rng);  // M x 2
-  const Var s6 = t.constant(targets);
+  const Var s6 = t.constant(intrinsic ? Block<T>(targets.leftCols(6)) : targets);
   const Var f_phi = atlas.phi_code(t, shape), f_psi = atlas.psi_code(t, shape);
   const bool jacobian = c.normals || c.isometry || c.chart;
 
@@ -58,8 +61,25 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
 
   // L_6D = Chamfer(phi6({x_P}), {x_S, n_S})   (Eq. 7); row 6: 3D points only.
   // With `dense`, phi6(x_P) finds its match in the whole pool (losses/chamfer.h).
-  const Var generated = c.normals ? first_m(all.phi6) : first_m(all.points);
-  const Var sampled = c.normals ? s6 : slice_cols(t, s6, 0, 3);
+  Var generated = c.normals ? first_m(all.phi6) : first_m(all.points);
+  Var sampled = c.normals ? s6 : slice_cols(t, s6, 0, 3);
+  if (intrinsic) {
+    // L_6D^h (objective.h): beta h_t(phi_t(x_P)), the reference's descriptor
+    // where its surface puts x_P, a constant of the step. phi_t runs on the
+    // values alone: nothing downstream reaches the loss, so backward skips it.
+    const Var x_fixed = t.constant(Block<T>(t.value(x_p)));
+    const Var code_t =
+        atlas.has_codes()
+            ? t.constant(Block<T>(t.value(atlas.phi_code(t, intrinsic->reference))))
+            : Var{};
+    const SurfacePoints on_t = atlas.phi.evaluate(t, p, x_fixed, false, code_t);
+    std::vector<int> near;
+    intrinsic->surface->query(t.value(on_t.points), near);
+    Block<T> h(m, intrinsic->descriptors->cols());
+    for (Index i = 0; i < m; ++i) h.row(i) = intrinsic->descriptors->row(near[size_t(i)]);
+    generated = concat_cols(t, {generated, t.constant(h)});
+    sampled = t.constant(targets);
+  }
   ChamferMatches<T>* const no_matches = nullptr;
   const Var surface = dense ? chamfer(t, generated, sampled, *dense, no_matches, w.coverage)
                             : chamfer(t, generated, sampled, no_matches, w.coverage);
@@ -139,7 +159,8 @@ Var objective_share(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>>& ta
     JSA_CHECK(shape >= 0 && shape < n, "shape " << shape << " of " << n);
     const NearestIndex<T>* dense = share.surfaces.empty() ? nullptr : share.surfaces[size_t(k)];
     const Var l = single_shape_objective(t, atlas, shape, targets[size_t(k)], m,
-                                         *share.rngs[size_t(k)], per_shape, &one, dense);
+                                         *share.rngs[size_t(k)], per_shape, &one, dense,
+                                         share.intrinsic);
     total = k == 0 ? l : add(t, total, l);
     sum_terms.surface += one.surface;
     sum_terms.chart += one.chart;
@@ -219,7 +240,7 @@ Var collection_objective(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>
 #define JSA_INSTANTIATE(T)                                                                       \
   template Var single_shape_objective<T>(Tape<T>&, Atlas<T>&, int, const Block<T>&, Index, Rng&, \
                                          const ObjectiveOptions&, LossTerms*,                    \
-                                         const NearestIndex<T>*);                                \
+                                         const NearestIndex<T>*, const IntrinsicField<T>*);      \
   template Var collection_objective<T>(                                                          \
       Tape<T>&, Atlas<T>&, const std::vector<Block<T>>&, Index, Rng&, const ObjectiveOptions&,   \
       LossTerms*, const std::vector<int>&, const std::vector<NearestIndex<T>>&);                 \

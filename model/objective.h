@@ -55,15 +55,35 @@ struct ObjectiveOptions {
   bool metric_conformal = false;
 };
 
+// Beyond the paper (issue 19, docs/collections.md, twelfth round): L_6D with
+// pose-invariant descriptors h (io/geometry/intrinsic_descriptors.h) appended to
+// both sides, so that one domain point lands where the shapes' surfaces agree
+// intrinsically (the hand on the hand, whether the arm is folded or held out):
+//
+//   L_6D^h = CD( [phi6_i(x_P), beta h_t(phi_t(x_P))],  [x_S, alpha n_S, beta h_i(x_S)] )
+//
+// t the reference shape (the template), h_t(y) the descriptor of t's sample
+// nearest to y: every shape is asked to carry at x the descriptor the reference
+// carries there. The targets then have 9 columns, the pool index too; h_t is a
+// constant of the step (no gradient flows through the look-up).
+template <class T>
+struct IntrinsicField {
+  int reference = 0;                         // t
+  const NearestIndex<T>* surface = nullptr;  // t's samples (3D points)
+  const Block<T>* descriptors = nullptr;     // beta h_t at those samples
+};
+
 // Builds L_single of shape `shape` (0 for a single shape) on the tape and returns
 // it (1 x 1). targets: rows [x_S, alpha n_S] sampled on the shape; `samples` 2D
 // points are drawn from P. surface: if given, L_6D is the dense variant (see
 // losses/chamfer.h) against this index over the shape's whole pool, rows
 // [x_S, alpha n_S] (or [x_S] when the normals are off).
+// intrinsic: L_6D^h instead of L_6D (targets M x 9 [x_S, alpha n_S, beta h_S]).
 template <class T>
 Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T>& targets,
                            Index samples, Rng& rng, const ObjectiveOptions& o, LossTerms* terms,
-                           const NearestIndex<T>* surface = nullptr);
+                           const NearestIndex<T>* surface = nullptr,
+                           const IntrinsicField<T>* intrinsic = nullptr);
 
 // L_full, Eq. (12): sum over the shapes of L_single. L_rep depends on mu alone,
 // so it is computed once and counted N times (as the sum does); a collection
@@ -89,6 +109,7 @@ struct ObjectiveShare {
   std::vector<int> shapes;                       // the shape of each target set
   std::vector<Rng*> rngs;                        // per target set: the draws of x_P
   std::vector<const NearestIndex<T>*> surfaces;  // empty, or per target set (dense L_6D)
+  const IntrinsicField<T>* intrinsic = nullptr;  // L_6D^h (targets M x 9), or L_6D
   int batch = 0;                     // B: the step's shapes over all shares (scale N / B)
   bool repulsion = true;             // this share adds N l_rep L_rep
   int code_begin = 0, code_end = 0;  // this share adds the prior of codes [begin, end)

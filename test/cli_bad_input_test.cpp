@@ -106,4 +106,6 @@ TEST_CASE("cli: flag values out of range are refused before any work", "[cli]") 
   rejects(fit + "--surface-lr-scale -1", 2, "--surface-lr-scale");
   // D reading the domain point exists only in a deformed collection.
   rejects(fit + "--deform-domain", 1, "--deform-domain: needs a collection");
+  rejects(fit + "--intrinsic -0.5", 2, "--intrinsic");
+  rejects(fit + "--intrinsic 0.5", 1, "--intrinsic: needs a collection");
 }

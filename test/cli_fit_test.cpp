@@ -200,6 +200,19 @@ TEST_CASE("cli: a collection with a shape batch and a user texture writes the te
   fs::remove(texture);
 }
 
+TEST_CASE("cli: a collection with the intrinsic descriptors in L_6D is fitted and saved",
+          "[cli]") {
+  const std::string dir = fresh_dir("intrinsic");
+  Result r = run("fit builtin:sphere builtin:capsule -o " + dir +
+                 " --iters 6 --template-steps 3 --code-size 8 --intrinsic 0.5" +
+                 kSmall.substr(0, kSmall.size() - 3));
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  CHECK(r.output.find("intrinsic descriptors on") != std::string::npos);
+  CHECK(read_text(dir + "/config.json").find("\"intrinsic\": 0.5") != std::string::npos);
+  CHECK(fs::exists(dir + "/shape_1/input_chart.obj"));
+}
+
 TEST_CASE("cli: moving flipped Gaussians is reported and saved", "[cli]") {
   // The inside-out sphere: the random start's sheet faces the wrong way somewhere.
   const std::string dir = fresh_dir("reseed");

@@ -466,3 +466,94 @@ TEST_CASE("objective: phi as a deformation per shape (deform_layers): gradients 
   CHECK((points(x, 0, nullptr, nullptr) - points(x, 1, nullptr, nullptr)).cwiseAbs().maxCoeff() >
         1e-3);
 }
+
+namespace {
+
+// One share of all shapes, with or without L_6D^h (model/objective.h).
+double intrinsic_share_value(Atlas<double>& atlas, const std::vector<Block<double>>& targets,
+                             const IntrinsicField<double>* field, Tape<double>& tape,
+                             bool backward) {
+  std::vector<Rng> rngs{Rng(99, 0), Rng(99, 1)};
+  ObjectiveShare<double> share;
+  share.shapes = {0, 1};
+  share.rngs = {&rngs[0], &rngs[1]};
+  share.batch = 2;
+  share.code_end = 2;
+  share.intrinsic = field;
+  tape.clear();
+  Var loss = objective_share(tape, atlas, targets, 24, ObjectiveOptions{}, share, nullptr);
+  if (backward) {
+    atlas.params.zero_grad();
+    tape.backward(loss);
+  }
+  return tape.scalar(loss);
+}
+
+}  // namespace
+
+TEST_CASE("objective: L_6D^h, descriptors appended to L_6D (intrinsic)", "[objective]") {
+  AtlasOptions ao = small_atlas_options();
+  ao.shapes = 2;
+  ao.code_size = 4;
+  ao.deform_layers = 2;
+  ao.softplus_beta = 10;
+  Atlas<double> atlas(ao);
+  Rng init(6);
+  atlas.initialize(init);
+  for (const char* name : {"phi.deform.w2", "phi.deform.b2"})
+    atlas.params.value(atlas.params.find(name)) *= 100.0;
+  const std::vector<Block<double>> six{random_targets(32, ao.alpha, 3),
+                                       random_targets(32, ao.alpha, 4)};
+  // The reference (shape 1) carries h = beta (x, y^2, z) at its samples; each
+  // shape's targets carry the same function of their own points.
+  const Block<double> reference_points = random_targets(400, ao.alpha, 7).leftCols(3);
+  auto h_of = [](const Block<double>& p, double beta) {
+    Block<double> h(p.rows(), 3);
+    h.col(0) = beta * p.col(0);
+    h.col(1) = beta * p.col(1).array().square().matrix();
+    h.col(2) = beta * p.col(2);
+    return h;
+  };
+  auto with_h = [&](double beta) {
+    std::vector<Block<double>> nine;
+    for (const Block<double>& t : six) {
+      Block<double> r(t.rows(), 9);
+      r << t, h_of(t.leftCols(3), beta);
+      nine.push_back(r);
+    }
+    return nine;
+  };
+  const NearestIndex<double> surface(reference_points);
+  Tape<double> tape;
+
+  // beta = 0: L_6D^h is L_6D.
+  const Block<double> zero = h_of(reference_points, 0);
+  const IntrinsicField<double> off{1, &surface, &zero};
+  const double plain = intrinsic_share_value(atlas, six, nullptr, tape, false);
+  CHECK(intrinsic_share_value(atlas, with_h(0), &off, tape, false) == Approx(plain).epsilon(1e-12));
+
+  // beta = 0.5: the descriptors change the value, and the gradient of every
+  // block matches central differences (h_t is piecewise constant in the
+  // parameters: small steps keep its look-ups).
+  const Block<double> half = h_of(reference_points, 0.5);
+  const IntrinsicField<double> on{1, &surface, &half};
+  const std::vector<Block<double>> targets = with_h(0.5);
+  const double value = intrinsic_share_value(atlas, targets, &on, tape, true);
+  CHECK(std::abs(value - plain) > 1e-4);
+  const std::vector<double> analytic = atlas.params.grads();
+  int checked = 0;
+  double worst = 0;
+  for (const char* name : {"codes.phi", "phi.deform.w0", "phi.w0", "phi.w2", "psi.wf", "domain.mu"}) {
+    const auto& e = atlas.params.entry(atlas.params.find(name));
+    worst = std::max(worst, worst_central_difference(
+                                atlas, analytic, e.offset, e.offset + size_t(e.rows * e.cols), 3,
+                                [&]() { return intrinsic_share_value(atlas, targets, &on, tape, false); },
+                                checked));
+  }
+  INFO(checked << " entries, worst error/tolerance " << worst);
+  CHECK(checked > 40);
+  CHECK(worst <= 1.0);
+  // 6-column targets with the field, or 9 without, are refused.
+  CHECK_THROWS(intrinsic_share_value(atlas, six, &on, tape, false));
+  CHECK_THROWS(intrinsic_share_value(atlas, targets, nullptr, tape, false));
+}

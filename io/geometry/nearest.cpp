@@ -144,6 +144,8 @@ void nearest(const Block<T>& queries, const Block<T>& points, std::vector<int>& 
       return nearest_kdtree<T, 3>(queries, points, index, squared_distance);
     case 6:
       return nearest_kdtree<T, 6>(queries, points, index, squared_distance);
+    case 9:  // L_6D with the intrinsic descriptors (io/geometry/intrinsic_descriptors.h)
+      return nearest_kdtree<T, 9>(queries, points, index, squared_distance);
     default:
       return nearest_kdtree<T, -1>(queries, points, index, squared_distance);
   }
@@ -185,6 +187,9 @@ NearestIndex<T>::NearestIndex(Block<T> points) {
       break;
     case 6:
       impl_ = std::make_unique<TreeImpl<T, 6>>(std::move(points));
+      break;
+    case 9:
+      impl_ = std::make_unique<TreeImpl<T, 9>>(std::move(points));
       break;
     default:
       impl_ = std::make_unique<TreeImpl<T, -1>>(std::move(points));

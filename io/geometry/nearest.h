@@ -18,7 +18,7 @@ namespace jsa {
 // queries: M x C, points: N x C (N >= 1). On return index has M entries,
 // index[i] = argmin_j |queries_i - points_j|^2, and if squared_distance is given
 // it holds the M minimal squared distances. All coordinates must be finite.
-// Tuned (fixed-size code) for C = 2, 3, 6; other C take a generic path.
+// Tuned (fixed-size code) for C = 2, 3, 6, 9; other C take a generic path.
 template <class T>
 void nearest(const Block<T>& queries, const Block<T>& points, std::vector<int>& index,
              std::vector<T>* squared_distance = nullptr);

@@ -96,6 +96,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["metric_conformal"] = o.metric_conformal;
   j["code_lr_scale"] = o.code_lr_scale;
   j["surface_lr_scale"] = o.surface_lr_scale;
+  j["intrinsic"] = o.intrinsic;
   j["parallel_shapes"] = o.parallel_shapes;
   j["pool"] = o.pool;
   j["threads"] = o.threads;
@@ -213,6 +214,10 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (j.contains("surface_lr_scale")) field(j, "", "surface_lr_scale", o.surface_lr_scale);
   if (!(o.surface_lr_scale >= 0) || !std::isfinite(o.surface_lr_scale))
     throw InputError(what + ": surface_lr_scale must be >= 0");
+  o.intrinsic = 0;  // later addition: absent = L_6D
+  if (j.contains("intrinsic")) field(j, "", "intrinsic", o.intrinsic);
+  if (!(o.intrinsic >= 0) || !std::isfinite(o.intrinsic))
+    throw InputError(what + ": intrinsic must be >= 0");
   o.parallel_shapes = false;  // later addition: runs before it took one shape at a time
   if (j.contains("parallel_shapes")) field(j, "", "parallel_shapes", o.parallel_shapes);
   o.metric_end = -1;  // later addition: absent = a constant lambda_metric

@@ -51,6 +51,7 @@ static void validate(const FitOptions& o) {
   require(std::isfinite(o.metric_end), "metric_end must be finite (< 0: lambda_metric constant)");
   require(o.code_lr_scale > 0 && std::isfinite(o.code_lr_scale),
           "code_lr_scale must be positive and finite");
+  require(o.intrinsic >= 0 && std::isfinite(o.intrinsic), "intrinsic must be >= 0 and finite");
   require(o.surface_lr_scale >= 0 && std::isfinite(o.surface_lr_scale),
           "surface_lr_scale must be >= 0 and finite");
   const ScheduleOptions& s = o.schedule;
@@ -94,12 +95,32 @@ Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools, T
       pools_.emplace_back(0, 6);  // another rank's shape
       continue;
     }
-    JSA_CHECK(pool.cols() == 6 && pool.rows() > 0, "a target pool must be P x 6");
-    pools_.push_back(pool.cast<float>());
+    const bool intrinsic = o.intrinsic > 0;
+    JSA_CHECK(pool.cols() == (intrinsic ? 9 : 6) && pool.rows() > 0,
+              (intrinsic ? "a target pool must be P x 9 [x_S, n_S, h_S] with --intrinsic"
+                         : "a target pool must be P x 6"));
+    pools_.push_back(pool.leftCols(6).cast<float>());
     pools_.back().rightCols(3) *= float(o.atlas.alpha);
-    if (o.dense_surface)
-      surfaces_.emplace_back(o.components.normals ? pools_.back()
-                                                  : Block<float>(pools_.back().leftCols(3)));
+    Block<float> index_rows =
+        o.components.normals ? pools_.back() : Block<float>(pools_.back().leftCols(3));
+    if (intrinsic) {
+      descriptors_.push_back(pool.rightCols(3).cast<float>() * float(o.intrinsic));
+      // L_6D^h's dense direction: the pool index over [x_S, alpha n_S, beta h_S].
+      Block<float> rows(index_rows.rows(), 9);
+      rows << index_rows, descriptors_.back();
+      index_rows = std::move(rows);
+      if (i == o.template_shape) {
+        reference_surface_ = std::make_unique<NearestIndex<float>>(pools_.back().leftCols(3));
+        reference_descriptors_ = descriptors_.back();
+      }
+    }
+    if (o.dense_surface) surfaces_.emplace_back(std::move(index_rows));
+  }
+  if (o.intrinsic > 0) {
+    if (n < 2) throw InputError("--intrinsic is for collections (two shapes or more)");
+    if (!o.components.normals) throw InputError("--intrinsic needs the normals in the loss");
+    if (!reference_surface_)
+      throw InputError("--intrinsic needs the template shape on every rank (not over MPI yet)");
   }
   const int b = o.batch_shapes > 0 && o.batch_shapes < n ? o.batch_shapes : n;
   for (int i = 0; i < b; ++i) batch_.push_back(i);
@@ -330,15 +351,24 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
   for (int s : batch)
     if (s >= first_shape_ && s < last_shape_) local_.push_back(s);
   targets_.resize(local_.size());
-  for (Block<float>& t : targets_) t.resize(points, 6);  // a no-op within a level of the ramp
+  const bool intrinsic = options_.intrinsic > 0;
+  // (made here, not kept: the trainer may move, its members with it)
+  const IntrinsicField<float> field{options_.template_shape, reference_surface_.get(),
+                                    &reference_descriptors_};
+  for (Block<float>& t : targets_)
+    t.resize(points, intrinsic ? 9 : 6);  // a no-op within a level of the ramp
   shape_rngs_.clear();
   for (int s : local_) shape_rngs_.emplace_back(key, uint64_t(s));
-  // M targets {x_S, n_S} per shape, drawn with replacement from its pool.
+  // M targets {x_S, n_S} (and beta h_S) per shape, drawn with replacement from its pool.
   for (size_t k = 0; k < local_.size(); ++k) {
     const Block<float>& pool = pools_[size_t(local_[k])];
     Rng& rng = shape_rngs_[k];
-    for (Index m = 0; m < points; ++m)
-      targets_[k].row(m) = pool.row(Index(rng.below(uint64_t(pool.rows()))));
+    for (Index m = 0; m < points; ++m) {
+      const Index r = Index(rng.below(uint64_t(pool.rows())));
+      targets_[k].row(m).head(6) = pool.row(r);
+      if (intrinsic)
+        targets_[k].row(m).tail(3) = descriptors_[size_t(local_[k] - first_shape_)].row(r);
+    }
   }
   ObjectiveOptions objective{options_.weights, options_.components, options_.repulsion_tolerance};
   if (atlas_->shapes() > 1) objective.metric_reference = options_.template_shape;  // L_metric's
@@ -375,6 +405,7 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
     share.repulsion = first_shape_ == 0 && w == 0;  // rank 0: N l_rep L_rep is counted once
     share.code_begin = w == 0 ? first_shape_ : 0;
     share.code_end = w == 0 ? last_shape_ : 0;
+    if (intrinsic) share.intrinsic = &field;
     std::vector<Block<float>>& own = worker_targets_[size_t(w)];
     if (workers > 1) own.resize(size_t(end - begin));
     for (int k = begin; k < end; ++k) {
@@ -508,8 +539,8 @@ bool Trainer::choose_orientation(int64_t counter, bool in_window) {
   double back = 0;
   for (size_t i = 0; i < targets_.size(); ++i) {
     Rng rng = check.stream(uint64_t(local_[i]));
-    back += back_facing_fraction(*atlas_, targets_[i], std::min<Index>(targets_[i].rows(), 2000),
-                                 rng, local_[i]);
+    const Block<float> six = targets_[i].leftCols(6);  // [x_S, alpha n_S] (not L_6D^h's h)
+    back += back_facing_fraction(*atlas_, six, std::min<Index>(six.rows(), 2000), rng, local_[i]);
   }
   if (team_ && team_->size() > 1) team_->sum_in_rank_order(&back, 1);
   if (back / double(batch_step_.size()) <= 0.5) return false;

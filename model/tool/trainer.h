@@ -117,6 +117,10 @@ struct FitOptions {
   // the template's surface and layout fixed once the template start is done,
   // so every shape is a deformation of one fixed surface; 1: one rate.
   double surface_lr_scale = 1;
+  // Collections: beta of L_6D^h (model/objective.h), the weight of the
+  // pose-invariant descriptors appended to L_6D; the pools then carry them as
+  // columns 7-9 (P x 9, io/geometry/intrinsic_descriptors.h). 0: L_6D.
+  double intrinsic = 0;
   // Collections: lambda_metric moves from weights.metric at the first joint
   // step to this value at the first learning-rate decay (geometrically;
   // model/tool/schedule.h, scheduled_weight), then stays. < 0: constant.
@@ -353,6 +357,11 @@ class Trainer {
       pools_;  // per shape P x 6, normals scaled by alpha (this rank's shapes only)
   std::vector<NearestIndex<float>>
       surfaces_;  // per shape of the block, over its pool (dense L_6D only)
+  // L_6D^h (FitOptions::intrinsic > 0): beta h per pool row, this rank's shapes;
+  // the reference's samples and its field (model/objective.h).
+  std::vector<Block<float>> descriptors_;
+  std::unique_ptr<NearestIndex<float>> reference_surface_;
+  Block<float> reference_descriptors_;
   Team* team_ = nullptr;
   int first_shape_ = 0, last_shape_ = 0;  // this rank's block of shapes
   std::vector<std::pair<size_t, size_t>>
