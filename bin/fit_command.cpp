@@ -347,8 +347,9 @@ void run_fit(FitArgs& a, Team& team) {
       // L_6D^h (model/objective.h): h at every pool sample, from the mesh's
       // vertices (in the pool's frame: to_unit turns them as the pool was turned).
       const IntrinsicDescriptors h = intrinsic_descriptors(shapes[i].mesh);
-      const Block<double> at = descriptors_at(
-          shapes[i].pool.leftCols(3), shapes[i].normalization.to_unit(h.nodes), h.values);
+      Block<double> at = descriptors_at(shapes[i].pool.leftCols(3),
+                                        shapes[i].normalization.to_unit(h.nodes), h.values);
+      rank_normalize(at);
       pools[i].conservativeResize(Eigen::NoChange, 9);
       pools[i].rightCols(3) = at;
       if (!a.quiet)

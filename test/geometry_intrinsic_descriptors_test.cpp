@@ -96,3 +96,24 @@ TEST_CASE("intrinsic descriptors: point clouds, pieces, and the look-up at point
   CHECK(h.row(0) == p.values.row(0));
   CHECK(h.row(1) == p.values.row(12 * 5 + 2));
 }
+
+TEST_CASE("intrinsic descriptors: ranks in [0, 1], ties share their mean rank",
+          "[geometry][intrinsic]") {
+  Block<double> v(5, 2);
+  v << 3, 1,  //
+      1, 1,   //
+      2, 1,   //
+      2, 5,   //
+      9, 0;
+  jsa::rank_normalize(v);
+  // Column 0: 1 < 2 = 2 < 3 < 9, ranks 0, 1.5, 3, 4 of 4.
+  CHECK(v(1, 0) == 0);
+  CHECK(v(2, 0) == Approx(1.5 / 4));
+  CHECK(v(3, 0) == Approx(1.5 / 4));
+  CHECK(v(0, 0) == Approx(0.75));
+  CHECK(v(4, 0) == 1);
+  // Column 1: 0 < 1 = 1 = 1 < 5.
+  CHECK(v(4, 1) == 0);
+  CHECK(v(0, 1) == Approx(0.5));
+  CHECK(v(3, 1) == 1);
+}

@@ -181,4 +181,27 @@ Block<double> descriptors_at(const Block<double>& points, const Block<double>& n
   return out;
 }
 
+void rank_normalize(Block<double>& values) {
+  const Index n = values.rows();
+  if (n < 2) {
+    values.setZero();
+    return;
+  }
+  std::vector<Index> order(static_cast<size_t>(n));
+  for (Index c = 0; c < values.cols(); ++c) {
+    for (Index i = 0; i < n; ++i) order[size_t(i)] = i;
+    std::sort(order.begin(), order.end(), [&](Index a, Index b) {
+      return values(a, c) < values(b, c) || (values(a, c) == values(b, c) && a < b);
+    });
+    Index i = 0;
+    while (i < n) {  // a run of equal values takes its mean rank
+      Index j = i + 1;
+      while (j < n && values(order[size_t(j)], c) == values(order[size_t(i)], c)) ++j;
+      const double rank = 0.5 * double(i + j - 1) / double(n - 1);
+      for (Index k = i; k < j; ++k) values(order[size_t(k)], c) = rank;
+      i = j;
+    }
+  }
+}
+
 }  // namespace jsa

@@ -43,4 +43,12 @@ IntrinsicDescriptors intrinsic_descriptors(const Mesh& mesh, const IntrinsicOpti
 Block<double> descriptors_at(const Block<double>& points, const Block<double>& nodes,
                              const Block<double>& values);
 
+// Each column replaced by its empirical distribution function over the rows,
+// rank / (N - 1) in [0, 1] (equal values share their mean rank). On a shape's
+// pool (uniform samples by area) this is the fraction of the surface with a
+// lower value: every shape's descriptors then have the same distribution, so
+// matching them moves no surface from one part to another (a pull that raw
+// values, offset from shape to shape, made: docs/collections.md, twelfth round).
+void rank_normalize(Block<double>& values);
+
 }  // namespace jsa
