@@ -102,6 +102,7 @@ auto with_flag_names(F&& f) {
       {"code_lr_scale", "--code-lr-scale"},
       {"surface_lr_scale", "--surface-lr-scale"},
       {"intrinsic", "--intrinsic"},
+      {"intrinsic_until", "--intrinsic-until"},
       {"schedule.kind", "--schedule"},
       {"schedule.points_start", "--points-start"},
       {"schedule.ramp_until", "--ramp-until"},
@@ -974,6 +975,12 @@ void add_fit(CLI::App& app) {
                 "along their surfaces (0: off)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1e3))
+      ->check(kFinite);
+  c->add_option("--intrinsic-until", o.intrinsic_until,
+                "With --intrinsic: the descriptors in the template start and this fraction of "
+                "--iters, then L_6D alone")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0))
       ->check(kFinite);
   c->add_option("--chart-from", o.chart_from,
                 "Staged objective: phi and P alone (no psi, L_2D, L_cycle) until this fraction of "

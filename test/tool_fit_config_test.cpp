@@ -187,6 +187,21 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   REQUIRE(domain_at != std::string::npos);
   before_domain.erase(domain_at, domain_key.size());
   CHECK(!jsa::fit_options_from_json(before_domain, "old").atlas.deform_domain);
+  // L_6D^h's weight and its stage: kept when set, off (and the whole run) when absent.
+  d.intrinsic = 0.25;
+  d.intrinsic_until = 0.5;
+  const jsa::FitOptions kept = jsa::fit_options_from_json(jsa::fit_options_to_json(d), "x");
+  CHECK(kept.intrinsic == 0.25);
+  CHECK(kept.intrinsic_until == 0.5);
+  std::string before_intrinsic = jsa::fit_options_to_json(d, -1);
+  for (const std::string key : {",\"intrinsic\":0.25", ",\"intrinsic_until\":0.5"}) {
+    const auto at = before_intrinsic.find(key);
+    REQUIRE(at != std::string::npos);
+    before_intrinsic.erase(at, key.size());
+  }
+  const jsa::FitOptions absent = jsa::fit_options_from_json(before_intrinsic, "old");
+  CHECK(absent.intrinsic == 0);
+  CHECK(absent.intrinsic_until == 1);
 }
 
 TEST_CASE("fit config: malformed JSON is rejected naming the source and the field",

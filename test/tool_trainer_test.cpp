@@ -450,6 +450,37 @@ TEST_CASE(
   CHECK(entry(a, "phi.deform.w0") != deform);
 }
 
+TEST_CASE("trainer: L_6D^h (intrinsic) in the first intrinsic_until of the run, then L_6D",
+          "[trainer]") {
+  // Pools of 9 columns: [x_S, n_S, h_S], h a function of the point (here its
+  // coordinates squared), as the CLI appends the intrinsic descriptors.
+  std::vector<Block<double>> nine;
+  for (const Block<double>& p : two_spheres()) {
+    Block<double> r(p.rows(), 9);
+    r << p, p.leftCols(3).array().square().matrix();
+    nine.push_back(r);
+  }
+  FitOptions o = small_options();
+  o.threads = 1;
+  o.iterations = 4;
+  o.intrinsic = 0.5;
+  FitOptions staged = o, plain = o;
+  staged.intrinsic_until = 0.5;
+  plain.intrinsic = 0;
+  Trainer a(o, nine), b(staged, nine), c(plain, two_spheres());
+  CHECK_THROWS(Trainer(o, two_spheres()));  // 6 columns with --intrinsic: refused
+  for (int i = 0; i < 3; ++i) {
+    a.step();
+    b.step();
+    c.step();
+    if (i == 0) CHECK(a.last().surface != c.last().surface);  // h counts in L_6D^h
+    if (i < 2)
+      CHECK(a.last().total == b.last().total);  // iterations 0, 1: both L_6D^h
+    else
+      CHECK(a.last().surface != b.last().surface);  // iteration 2: b is on L_6D
+  }
+}
+
 TEST_CASE("trainer: chart_from trains phi and P alone until that fraction of the run",
           "[trainer]") {
   FitOptions o = small_options();

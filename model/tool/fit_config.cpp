@@ -97,6 +97,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["code_lr_scale"] = o.code_lr_scale;
   j["surface_lr_scale"] = o.surface_lr_scale;
   j["intrinsic"] = o.intrinsic;
+  j["intrinsic_until"] = o.intrinsic_until;
   j["parallel_shapes"] = o.parallel_shapes;
   j["pool"] = o.pool;
   j["threads"] = o.threads;
@@ -218,6 +219,10 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (j.contains("intrinsic")) field(j, "", "intrinsic", o.intrinsic);
   if (!(o.intrinsic >= 0) || !std::isfinite(o.intrinsic))
     throw InputError(what + ": intrinsic must be >= 0");
+  o.intrinsic_until = 1;  // later addition: absent = the whole run
+  if (j.contains("intrinsic_until")) field(j, "", "intrinsic_until", o.intrinsic_until);
+  if (!(o.intrinsic_until >= 0 && o.intrinsic_until <= 1))
+    throw InputError(what + ": intrinsic_until must be in [0, 1]");
   o.parallel_shapes = false;  // later addition: runs before it took one shape at a time
   if (j.contains("parallel_shapes")) field(j, "", "parallel_shapes", o.parallel_shapes);
   o.metric_end = -1;  // later addition: absent = a constant lambda_metric

@@ -52,6 +52,7 @@ static void validate(const FitOptions& o) {
   require(o.code_lr_scale > 0 && std::isfinite(o.code_lr_scale),
           "code_lr_scale must be positive and finite");
   require(o.intrinsic >= 0 && std::isfinite(o.intrinsic), "intrinsic must be >= 0 and finite");
+  require(o.intrinsic_until >= 0 && o.intrinsic_until <= 1, "intrinsic_until must be in [0, 1]");
   require(o.surface_lr_scale >= 0 && std::isfinite(o.surface_lr_scale),
           "surface_lr_scale must be >= 0 and finite");
   const ScheduleOptions& s = o.schedule;
@@ -108,7 +109,7 @@ Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools, T
       // L_6D^h's dense direction: the pool index over [x_S, alpha n_S, beta h_S].
       Block<float> rows(index_rows.rows(), 9);
       rows << index_rows, descriptors_.back();
-      index_rows = std::move(rows);
+      if (o.dense_surface) intrinsic_surfaces_.emplace_back(std::move(rows));
       if (i == o.template_shape) {
         reference_surface_ = std::make_unique<NearestIndex<float>>(pools_.back().leftCols(3));
         reference_descriptors_ = descriptors_.back();
@@ -351,7 +352,10 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
   for (int s : batch)
     if (s >= first_shape_ && s < last_shape_) local_.push_back(s);
   targets_.resize(local_.size());
-  const bool intrinsic = options_.intrinsic > 0;
+  // L_6D^h in the template start and until intrinsic_until of the iterations, then L_6D.
+  const bool intrinsic =
+      options_.intrinsic > 0 &&
+      (template_step || double(iteration_) < options_.intrinsic_until * double(options_.iterations));
   // (made here, not kept: the trainer may move, its members with it)
   const IntrinsicField<float> field{options_.template_shape, reference_surface_.get(),
                                     &reference_descriptors_};
@@ -411,8 +415,9 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
     for (int k = begin; k < end; ++k) {
       share.shapes.push_back(local_[size_t(k)]);
       share.rngs.push_back(&shape_rngs_[size_t(k)]);
-      if (!surfaces_.empty())
-        share.surfaces.push_back(&surfaces_[size_t(local_[size_t(k)] - first_shape_)]);
+      const std::vector<NearestIndex<float>>& dense = intrinsic ? intrinsic_surfaces_ : surfaces_;
+      if (!dense.empty())
+        share.surfaces.push_back(&dense[size_t(local_[size_t(k)] - first_shape_)]);
       if (workers > 1) own[size_t(k - begin)] = targets_[size_t(k)];  // storage kept between steps
     }
     const std::vector<Block<float>>& targets = workers > 1 ? own : targets_;

@@ -121,6 +121,10 @@ struct FitOptions {
   // pose-invariant descriptors appended to L_6D; the pools then carry them as
   // columns 7-9 (P x 9, io/geometry/intrinsic_descriptors.h). 0: L_6D.
   double intrinsic = 0;
+  // ... in the template start and the first this fraction of the iterations,
+  // then L_6D: the descriptors place the layouts, the extrinsic terms finish
+  // the surfaces. 1: the whole run.
+  double intrinsic_until = 1;
   // Collections: lambda_metric moves from weights.metric at the first joint
   // step to this value at the first learning-rate decay (geometrically;
   // model/tool/schedule.h, scheduled_weight), then stays. < 0: constant.
@@ -360,6 +364,7 @@ class Trainer {
   // L_6D^h (FitOptions::intrinsic > 0): beta h per pool row, this rank's shapes;
   // the reference's samples and its field (model/objective.h).
   std::vector<Block<float>> descriptors_;
+  std::vector<NearestIndex<float>> intrinsic_surfaces_;  // over [x_S, alpha n_S, beta h_S]
   std::unique_ptr<NearestIndex<float>> reference_surface_;
   Block<float> reference_descriptors_;
   Team* team_ = nullptr;
