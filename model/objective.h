@@ -65,7 +65,9 @@ struct ObjectiveOptions {
 // t the reference shape (the template), h_t(y) the descriptor of t's sample
 // nearest to y: every shape is asked to carry at x the descriptor the reference
 // carries there. The targets then have 9 columns, the pool index too; h_t is a
-// constant of the step (no gradient flows through the look-up).
+// constant of the step (no gradient flows through the look-up). Measured: the
+// teddies' hand moves (46 -> 38-42 x 1e-2) but every variant tried carries the
+// keypoints no better and reconstructs worse, so it is off by default.
 template <class T>
 struct IntrinsicField {
   int reference = 0;                         // t
