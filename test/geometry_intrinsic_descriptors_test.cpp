@@ -97,7 +97,7 @@ TEST_CASE("intrinsic descriptors: point clouds, pieces, and the look-up at point
   CHECK(h.row(1) == p.values.row(12 * 5 + 2));
 }
 
-TEST_CASE("intrinsic descriptors: ranks in [0, 1], ties share their mean rank",
+TEST_CASE("intrinsic descriptors: ranks from 0 to 1, ties share their mean rank",
           "[geometry][intrinsic]") {
   Block<double> v(5, 2);
   v << 3, 1,  //
