@@ -161,16 +161,20 @@ TEST_CASE(
   }
 }
 
-TEST_CASE("cli: a collection with a shape batch and a user texture writes the texture transfer",
-          "[cli]") {
+TEST_CASE(
+    "cli: a collection with a shape batch, the intrinsic descriptors and a user texture writes the "
+    "texture transfer",
+    "[cli]") {
   const std::string dir = fresh_dir("texture");
   const std::string texture = dir + "/../jsatlas_test_paint_" + std::to_string(::getpid()) + ".png";
   jsa::write_png(texture, jsa::checkerboard(64, 8));
   Result r = run("fit builtin:sphere builtin:capsule builtin:torus -o " + dir +
-                 " --iters 12 --batch-shapes 2 --code-size 8 --texture " + texture + kSmall);
+                 " --iters 12 --batch-shapes 2 --code-size 8 --intrinsic 0.5 --texture " +
+                 texture + kSmall);
   INFO(r.output);
   REQUIRE(r.code == 0);
   CHECK(read_text(dir + "/config.json").find("\"batch_shapes\": 2") != std::string::npos);
+  CHECK(read_text(dir + "/config.json").find("\"intrinsic\": 0.5") != std::string::npos);
   // The template (-1 by default: the medoid) is saved as the shape chosen.
   const std::string config = read_text(dir + "/config.json");
   const auto at = config.find("\"template_shape\": ");
@@ -198,19 +202,6 @@ TEST_CASE("cli: a collection with a shape batch and a user texture writes the te
   CHECK(r.code == 1);
   CHECK(r.output.find("--template-shape") != std::string::npos);
   fs::remove(texture);
-}
-
-TEST_CASE("cli: a collection with the intrinsic descriptors in L_6D is fitted and saved",
-          "[cli]") {
-  const std::string dir = fresh_dir("intrinsic");
-  Result r = run("fit builtin:sphere builtin:capsule -o " + dir +
-                 " --iters 6 --template-steps 3 --code-size 8 --intrinsic 0.5" +
-                 kSmall.substr(0, kSmall.size() - 3));
-  INFO(r.output);
-  REQUIRE(r.code == 0);
-  CHECK(r.output.find("intrinsic descriptors on") != std::string::npos);
-  CHECK(read_text(dir + "/config.json").find("\"intrinsic\": 0.5") != std::string::npos);
-  CHECK(fs::exists(dir + "/shape_1/input_chart.obj"));
 }
 
 TEST_CASE("cli: moving flipped Gaussians is reported and saved", "[cli]") {
