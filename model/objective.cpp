@@ -68,10 +68,9 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
     // where its surface puts x_P, a constant of the step. phi_t runs on the
     // values alone: nothing downstream reaches the loss, so backward skips it.
     const Var x_fixed = t.constant(Block<T>(t.value(x_p)));
-    const Var code_t =
-        atlas.has_codes()
-            ? t.constant(Block<T>(t.value(atlas.phi_code(t, intrinsic->reference))))
-            : Var{};
+    const Var code_t = atlas.has_codes()
+                           ? t.constant(Block<T>(t.value(atlas.phi_code(t, intrinsic->reference))))
+                           : Var{};
     const SurfacePoints on_t = atlas.phi.evaluate(t, p, x_fixed, false, code_t);
     std::vector<int> near;
     intrinsic->surface->query(t.value(on_t.points), near);
@@ -158,9 +157,9 @@ Var objective_share(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>>& ta
     const int shape = share.shapes[size_t(k)];
     JSA_CHECK(shape >= 0 && shape < n, "shape " << shape << " of " << n);
     const NearestIndex<T>* dense = share.surfaces.empty() ? nullptr : share.surfaces[size_t(k)];
-    const Var l = single_shape_objective(t, atlas, shape, targets[size_t(k)], m,
-                                         *share.rngs[size_t(k)], per_shape, &one, dense,
-                                         share.intrinsic);
+    const Var l =
+        single_shape_objective(t, atlas, shape, targets[size_t(k)], m, *share.rngs[size_t(k)],
+                               per_shape, &one, dense, share.intrinsic);
     total = k == 0 ? l : add(t, total, l);
     sum_terms.surface += one.surface;
     sum_terms.chart += one.chart;

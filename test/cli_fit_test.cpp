@@ -169,8 +169,8 @@ TEST_CASE(
   const std::string texture = dir + "/../jsatlas_test_paint_" + std::to_string(::getpid()) + ".png";
   jsa::write_png(texture, jsa::checkerboard(64, 8));
   Result r = run("fit builtin:sphere builtin:capsule builtin:torus -o " + dir +
-                 " --iters 12 --batch-shapes 2 --code-size 8 --intrinsic 0.5 --texture " +
-                 texture + kSmall);
+                 " --iters 12 --batch-shapes 2 --code-size 8 --intrinsic 0.5 --texture " + texture +
+                 kSmall);
   INFO(r.output);
   REQUIRE(r.code == 0);
   CHECK(read_text(dir + "/config.json").find("\"batch_shapes\": 2") != std::string::npos);

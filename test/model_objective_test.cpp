@@ -543,12 +543,14 @@ TEST_CASE("objective: L_6D^h, descriptors appended to L_6D (intrinsic)", "[objec
   const std::vector<double> analytic = atlas.params.grads();
   int checked = 0;
   double worst = 0;
-  for (const char* name : {"codes.phi", "phi.deform.w0", "phi.w0", "phi.w2", "psi.wf", "domain.mu"}) {
+  for (const char* name :
+       {"codes.phi", "phi.deform.w0", "phi.w0", "phi.w2", "psi.wf", "domain.mu"}) {
     const auto& e = atlas.params.entry(atlas.params.find(name));
-    worst = std::max(worst, worst_central_difference(
-                                atlas, analytic, e.offset, e.offset + size_t(e.rows * e.cols), 3,
-                                [&]() { return intrinsic_share_value(atlas, targets, &on, tape, false); },
-                                checked));
+    worst = std::max(
+        worst,
+        worst_central_difference(
+            atlas, analytic, e.offset, e.offset + size_t(e.rows * e.cols), 3,
+            [&]() { return intrinsic_share_value(atlas, targets, &on, tape, false); }, checked));
   }
   INFO(checked << " entries, worst error/tolerance " << worst);
   CHECK(checked > 40);

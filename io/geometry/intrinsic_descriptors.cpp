@@ -78,7 +78,8 @@ double quantile(const std::vector<double>& sorted, double q) {
 }  // namespace
 
 IntrinsicDescriptors intrinsic_descriptors(const Mesh& mesh, const IntrinsicOptions& o) {
-  JSA_CHECK(o.sources >= 1 && o.neighbours >= 1, "intrinsic descriptors: sources and neighbours >= 1");
+  JSA_CHECK(o.sources >= 1 && o.neighbours >= 1,
+            "intrinsic descriptors: sources and neighbours >= 1");
   JSA_CHECK(mesh.vertices.rows() > 0, "intrinsic descriptors of an empty shape");
   IntrinsicDescriptors out;
   std::vector<std::pair<int, int>> edges;
@@ -116,7 +117,8 @@ IntrinsicDescriptors intrinsic_descriptors(const Mesh& mesh, const IntrinsicOpti
       }
     });
     for (Index i = 0; i < g; ++i)
-      for (int j : near[size_t(i)]) edges.push_back({int(std::min<Index>(i, j)), int(std::max<Index>(i, j))});
+      for (int j : near[size_t(i)])
+        edges.push_back({int(std::min<Index>(i, j)), int(std::max<Index>(i, j))});
     const Eigen::RowVector3d mean = out.nodes.colwise().mean();
     unit = std::max(1e-12, (out.nodes.rowwise() - mean).rowwise().norm().maxCoeff());
   }

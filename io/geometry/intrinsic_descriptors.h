@@ -26,12 +26,12 @@ namespace jsa {
 constexpr int kIntrinsicChannels = 3;
 
 struct IntrinsicOptions {
-  int sources = 64;  // S
+  int sources = 64;    // S
   int neighbours = 8;  // graph of a point cloud: each point joined to its k nearest
 };
 
 struct IntrinsicDescriptors {
-  Block<double> nodes;   // G x 3: the graph's vertices (the mesh's; a cloud's, at most 4000 of them)
+  Block<double> nodes;  // G x 3: the graph's vertices (the mesh's; a cloud's, at most 4000 of them)
   Block<double> values;  // G x kIntrinsicChannels: h at each node
 };
 

@@ -353,9 +353,9 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
     if (s >= first_shape_ && s < last_shape_) local_.push_back(s);
   targets_.resize(local_.size());
   // L_6D^h in the template start and until intrinsic_until of the iterations, then L_6D.
-  const bool intrinsic =
-      options_.intrinsic > 0 &&
-      (template_step || double(iteration_) < options_.intrinsic_until * double(options_.iterations));
+  const bool intrinsic = options_.intrinsic > 0 &&
+                         (template_step || double(iteration_) < options_.intrinsic_until *
+                                                                    double(options_.iterations));
   // (made here, not kept: the trainer may move, its members with it)
   const IntrinsicField<float> field{options_.template_shape, reference_surface_.get(),
                                     &reference_descriptors_};
