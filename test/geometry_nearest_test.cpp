@@ -106,6 +106,11 @@ TEMPLATE_TEST_CASE("a NearestIndex built once answers like nearest() on every qu
   Block<TestType> nan_q = random_block<TestType>(5, 3, 53);
   nan_q(2, 1) = std::numeric_limits<TestType>::quiet_NaN();
   CHECK_THROWS(b.query(nan_q, idx));
+  // A pool with a NaN is refused when its index is built: queries no longer
+  // rescan the pool.
+  Block<TestType> nan_pool = random_block<TestType>(300, 3, 54);
+  nan_pool(120, 2) = std::numeric_limits<TestType>::quiet_NaN();
+  CHECK_THROWS(NearestIndex<TestType>(nan_pool));
 }
 
 TEMPLATE_TEST_CASE("nearest of the points themselves is themselves", "[nearest]", float, double) {
