@@ -9,7 +9,8 @@
 //       --blas /usr/lib/x86_64-linux-gnu/blis-openmp/libblas.so.3
 //
 // Shapes: the stacked rows of one layer (value and two tangents, 3M rows) at the
-// default (M = 2500, 128 wide) and the paper (M = 10^4, 256 wide) sizes, the
+// default (M = 2500, 128 wide), the paper (M = 10^4, 256 wide) and a collection
+// shape's (2M = 2000 points, 64 wide) sizes, the
 // three products of a layer's step: Y = X W (forward), dW = X^T dY and
 // dX = dY W^T (backward). Every library's result is checked against Eigen's
 // before it is timed. Medians of --runs repetitions, GFLOP/s per product.
@@ -69,9 +70,12 @@ int main(int argc, char** argv) {
     }
     blas.push_back({path, f});
   }
-  const std::vector<Shape> shapes{{"default", 2500, 128}, {"paper", 10000, 256}};
+  // "collection": one shape's phi pass in a collection step (2M = 2000 points at
+  // M = 1000, 5 x 64 networks), the GEMMs a per-shape worker runs on one thread.
+  const std::vector<Shape> shapes{
+      {"default", 2500, 128}, {"paper", 10000, 256}, {"collection", 2000, 64}};
   std::printf("threads %d, runs %d (median); GFLOP/s\n", threads, runs);
-  std::printf("%-8s %-9s %-70s %8s\n", "config", "product", "library", "GFLOP/s");
+  std::printf("%-10s %-9s %-70s %8s\n", "config", "product", "library", "GFLOP/s");
   for (const Shape& s : shapes) {
     const int r = 3 * s.points, w = s.width;
     const Mat X = Mat::Random(r, w), W = Mat::Random(w, w), dY = Mat::Random(r, w);
@@ -107,7 +111,7 @@ int main(int argc, char** argv) {
         return flops / bench::median(sec) * 1e-9;
       };
       eigen(ref);
-      std::printf("%-8s %-9s %-70s %8.1f\n", s.name.c_str(), p.name, "Eigen", time(eigen));
+      std::printf("%-10s %-9s %-70s %8.1f\n", s.name.c_str(), p.name, "Eigen", time(eigen));
       for (const auto& [path, f] : blas) {
         Mat C(p.rows, p.cols);
         gemm_rowmajor(f, p.ta, p.tb, p.A, p.B, C);
@@ -117,7 +121,7 @@ int main(int argc, char** argv) {
                        err);
           return 1;
         }
-        std::printf("%-8s %-9s %-70s %8.1f\n", s.name.c_str(), p.name, path.c_str(),
+        std::printf("%-10s %-9s %-70s %8.1f\n", s.name.c_str(), p.name, path.c_str(),
                     time([&](Mat& out) { gemm_rowmajor(f, p.ta, p.tb, p.A, p.B, out); }));
       }
     }

@@ -11,7 +11,7 @@ namespace {
 // Elementwise choices as plain loops over n contiguous entries: GCC turns the
 // ternary into a vector blend, where Eigen's `select` on these array
 // expressions ran one coefficient at a time (5.2 against 0.29 ns an entry on an
-// AVX2 core, docs/performance.md; the same bits).
+// AVX2 core: docs/performance.md, "Eigen's select"; the same bits).
 
 // out = [z > 0] * x
 template <class T>
