@@ -122,7 +122,7 @@ void nearest_kdtree(const Block<T>& queries, const Block<T>& points, std::vector
 
 // `points_checked`: the points' finiteness was checked when their index was built
 // (a NearestIndex's pool is fixed, and scanning 10^5-10^6 floats on every query
-// cost 1.6% of a training step).
+// cost 1.7-2.1% of a training step, docs/performance.md).
 template <class T>
 void check_shapes(const Block<T>& queries, const Block<T>& points, bool points_checked = false) {
   JSA_CHECK(points.rows() >= 1, "nearest: no points to search");
