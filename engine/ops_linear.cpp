@@ -2,6 +2,7 @@
 // plain and stacked-tangent form.
 #include <cmath>
 
+#include "engine/gemm.h"
 #include "engine/ops.h"
 #include "engine/parallel.h"
 
@@ -39,7 +40,7 @@ Var linear(Tape<T>& t, Var x, Var w, Var b, Index bias_rows) {
   JSA_CHECK(bias_rows <= n, "linear: bias on " << bias_rows << " rows of " << n);
   Var y = b.valid() ? t.node(n, cout, {x, w, b}) : t.node(n, cout, {x, w});
   Block<T>& Y = t.value(y);
-  Y.noalias() = t.value(x) * t.value(w);  // one GEMM, threaded by Eigen
+  gemm(t.value(x), false, t.value(w), false, Y, false);  // one GEMM (engine/gemm.h), threaded
   if (b.valid()) {
     JSA_CHECK(t.rows(b) == 1 && t.cols(b) == cout, "linear: bias must be 1x" << cout);
     const auto bias = t.value(b).row(0);
@@ -47,10 +48,19 @@ Var linear(Tape<T>& t, Var x, Var w, Var b, Index bias_rows) {
                   [&](Index r0, Index r1) { Y.middleRows(r0, r1 - r0).rowwise() += bias; });
   }
   // dX += dY W^T ;  dW += X^T dY ;  db += sum over the biased rows of dY
+  // Each GEMM writes every entry of its gradient, so a first writer assigns
+  // (beta = 0 in BLAS terms) and its block is never zeroed (Tape::grad_to_overwrite).
   t.on_backward(y, [x, w, b, bias_rows](Tape<T>& t, Var y) {
     const Block<T>& dY = t.grad(y);
-    if (t.needs_grad(x)) t.grad(x).noalias() += dY * t.value(w).transpose();
-    if (t.needs_grad(w)) t.grad(w).noalias() += t.value(x).transpose() * dY;
+    bool first = false;
+    if (t.needs_grad(x)) {
+      Block<T>& dX = t.grad_to_overwrite(x, &first);
+      gemm(dY, false, t.value(w), true, dX, !first);
+    }
+    if (t.needs_grad(w)) {
+      Block<T>& dW = t.grad_to_overwrite(w, &first);
+      gemm(t.value(x), true, dY, false, dW, !first);
+    }
     if (b.valid() && t.needs_grad(b)) {
       // A plain loop over rows: contiguous in row-major dY (Eigen's colwise()
       // sum strides down each column, ~8x slower here), and serial, so the sum

@@ -8,6 +8,8 @@
 #include <xmmintrin.h>
 #endif
 
+#include "engine/gemm.h"
+
 namespace jsa {
 
 int max_threads() { return omp_get_max_threads(); }
@@ -37,6 +39,7 @@ void set_threads(int n) {
   if (n > 0) {
     omp_set_num_threads(n);
     Eigen::setNbThreads(n);
+    set_blas_threads(n);  // a BLAS with threads of its own (engine/gemm.h)
   }
   if (std::getenv("JSATLAS_KEEP_DENORMALS")) return;
   // Each thread has its own MXCSR; threads started later copy their creator's.

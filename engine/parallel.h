@@ -37,7 +37,8 @@ void parallel_rows(Index n, F&& f, Index grain = 2048) {
   }
 }
 
-// Sets the thread count for OpenMP and Eigen's GEMM; 0 keeps the default.
+// Sets the thread count for OpenMP, Eigen's GEMM and the BLAS's (engine/gemm.h);
+// 0 keeps the default.
 // Also turns denormal floats off on the calling thread and on every OpenMP
 // thread (flush-to-zero and denormals-are-zero, x86's MXCSR): a trained
 // softplus network is full of them (the tangent rows s'(z) x_k of Eq. 2's

@@ -8,9 +8,12 @@ set -euo pipefail
 # OpenBLAS (its OpenMP build) under it: 6-7x Eigen's SimplicialLDLT on a
 # 250k-vertex chart (io/geometry/sparse_spd.h). The build falls back to Eigen
 # without them (-DJSATLAS_CHOLMOD=OFF).
+# libblas-dev: cblas.h and the link library of the GEMMs' BLAS backend
+# (engine/gemm.h, `fit --gemm`); at run time libblas.so.3 is OpenBLAS's OpenMP
+# build, by Debian's alternatives. Without it the build has Eigen alone.
 pkgs=(cmake g++ make pkg-config libeigen3-dev libnanoflann-dev libtinyobjloader-dev catch2
       libcli11-dev nlohmann-json3-dev libstb-dev libjs-three libsuitesparse-dev
-      libopenblas0-openmp)
+      libopenblas0-openmp libblas-dev)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

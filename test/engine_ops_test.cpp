@@ -13,6 +13,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "engine/gemm.h"
 #include "engine/ops.h"
 #include "engine/tangents.h"
 #include "test/engine_gradcheck_cases.h"
@@ -320,7 +321,10 @@ TEST_CASE("tall blocks (parallel path) equal a plain loop", "[ops][parallel]") {
 }
 
 // float and double instantiations compute the same thing (to float precision).
-TEST_CASE("float ops agree with double ops", "[ops][float]") {
+// With the BLAS backend selected the float linear ops go through it (double
+// stays on Eigen), so this is also the gradient check of the BLAS's pull-backs:
+// against the double ones check_gradients verifies.
+void float_and_double_agree() {
   Rng rng(23);
   const Block<double> x0 = signed_block(rng, 9, 3), w0 = signed_block(rng, 3, 3),
                       b0 = signed_block(rng, 1, 3);
@@ -341,6 +345,33 @@ TEST_CASE("float ops agree with double ops", "[ops][float]") {
   const auto [ld, gd] = run(0.0);
   CHECK(lf == Approx(ld).epsilon(1e-5));
   CHECK((gf - gd).cwiseAbs().maxCoeff() < 1e-5 * std::max(1.0, gd.cwiseAbs().maxCoeff()));
+}
+
+TEST_CASE("float ops agree with double ops", "[ops][float]") { float_and_double_agree(); }
+
+// The engine's checks with the GEMMs on the BLAS (engine/gemm.h), when the
+// build has one: the gradient checks (double, so still Eigen's products: the
+// other ops must not care which backend is selected) and the float-double
+// agreement, whose float side now runs on the BLAS.
+TEST_CASE("with the BLAS backend selected the gradient checks and float ops still pass",
+          "[ops][gradcheck][gemm]") {
+  if (!blas_built_in()) {
+    CHECK_THROWS_AS(set_gemm(Gemm::blas), InputError);
+    return;
+  }
+  set_gemm(Gemm::blas);
+  for (const GradCase& g : op_cases()) {
+    const GradCheckResult r = check_gradients(g.f, g.inputs, g.options);
+    INFO(table_line(g.op, r) << "\n" << r.report);
+    CHECK(r.ok);
+  }
+  for (const GradCase& g : jacobian_cases()) {
+    const GradCheckResult r = check_gradients(g.f, g.inputs, g.options);
+    INFO(table_line(g.op, r) << "\n" << r.report);
+    CHECK(r.ok);
+  }
+  float_and_double_agree();
+  set_gemm(Gemm::eigen);
 }
 
 }  // namespace jsa::test
