@@ -27,6 +27,7 @@
 #include "io/pictures/image.h"
 #include "model/tool/checkpoint.h"
 #include "model/tool/fit_config.h"
+#include "model/tool/gemm_choice.h"
 #include "model/tool/mpi/mpi_team.h"
 #include "model/tool/pose_by_fit.h"
 #include "model/tool/shape_input.h"
@@ -42,6 +43,7 @@ struct FitArgs {
   std::string list_file, out_dir, resume;
   FitOptions options;
   int threads = -1;  // -1: not given (a resumed run keeps its own)
+  std::string gemm;  // --gemm auto|eigen|blas; "": not given (auto; a resumed run keeps its own)
   int checkpoint_every = 500;
   int table_row = 0;
   bool no_normals = false, no_repulsion = false, no_distribution = false, no_chart = false,
@@ -249,6 +251,39 @@ void run_fit(FitArgs& a, Team& team) {
   }
   if (a.threads >= 0) o.threads = a.threads;
   set_threads(o.threads);
+  // The GEMMs' backend (engine/gemm.h), before anything multiplies. `auto`
+  // measures on this run's own step, or reads the machine's earlier answer
+  // (model/tool/gemm_choice.h: why a measured choice must be remembered);
+  // rank 0 decides for an MPI job. A resumed run keeps its own, as its threads.
+  GemmChoice gemm;
+  std::string gemm_asked = resuming ? "resume" : "auto";
+  if (!a.gemm.empty()) gemm_asked = a.gemm;
+  if (gemm_asked == "auto") {
+    if (root)
+      gemm = with_flag_names([&] { return choose_gemm(o, int(inputs.size()), gemm_cache_path()); });
+    if (many) {
+      double blas = root && gemm.gemm == Gemm::blas ? 1.0 : 0.0;
+      team.sum_in_rank_order(&blas, 1);
+      gemm.gemm = blas > 0 ? Gemm::blas : Gemm::eigen;
+    }
+  } else if (gemm_asked == "resume") {
+    gemm.gemm = o.gemm;
+    gemm.source = "the run's own, from its checkpoint";
+    if (o.gemm == Gemm::blas && !blas_built_in())
+      throw InputError("fit --resume: " + a.resume +
+                       " ran its GEMMs on the BLAS, which this jsatlas was built without "
+                       "(rebuild with a CBLAS, or resume with --gemm eigen: the numbers then "
+                       "differ from an uninterrupted run's)");
+  } else {
+    parse_gemm(gemm_asked, &gemm.gemm);  // CLI11 has checked the name
+    gemm.source = "--gemm " + gemm_asked;
+    if (gemm.gemm == Gemm::blas && !blas_built_in())
+      throw InputError(
+          "--gemm blas: this jsatlas was built without a CBLAS (install libblas-dev and "
+          "libopenblas0-openmp, then rebuild; or use --gemm eigen)");
+  }
+  o.gemm = gemm.gemm;
+  set_gemm(o.gemm);
   if (many && !resuming) {
     // Before the inputs are read and posed (minutes on large meshes). The
     // automatic template start (-1) is turned off below, not refused.
@@ -458,10 +493,31 @@ void run_fit(FitArgs& a, Team& team) {
               << (many ? " on each of " + std::to_string(team.size()) + " MPI ranks"
                        : std::string())
               << (resuming ? ", resumed at " + std::to_string(trainer.iteration()) : std::string())
-              << ")\n";
+              << ")\n"
+              << "fit: " << describe(gemm) << "\n";
 
+  // What chose the backend, for config.json: a resumed run keeps its first
+  // record (the settings hold the backend itself).
+  nlohmann::json gemm_record = {{"backend", gemm_name(gemm.gemm)},
+                                {"asked", gemm_asked},
+                                {"source", gemm.source},
+                                {"eigen_ms", gemm.timing.eigen_seconds * 1e3},
+                                {"blas_ms", gemm.timing.blas_seconds * 1e3},
+                                {"repeats", gemm.timing.repeats},
+                                {"blas", blas_description()},
+                                {"cache", gemm.cache},
+                                {"cache_key", gemm.key}};
+  if (gemm_asked == "resume") {
+    try {
+      std::ifstream in(dir + "/config.json");
+      const nlohmann::json old = nlohmann::json::parse(in);
+      if (old.contains("gemm") && old["gemm"].is_object()) gemm_record = old["gemm"];
+    } catch (const std::exception&) {
+      // no earlier record (a run from before --gemm): the one above
+    }
+  }
   // config.json: the settings, and what the run has done so far (faults and
-  // the action taken for each, mirrors, reseeds).
+  // the action taken for each, mirrors, reseeds), and the GEMMs' choice.
   auto write_config = [&]() {
     if (!root) return;
     write_file_atomically(dir + "/config.json", [&](std::ostream& out) {
@@ -469,6 +525,7 @@ void run_fit(FitArgs& a, Team& team) {
       for (size_t i = 0; i < inputs.size(); ++i) out << (i ? ", " : "") << json_quote(inputs[i]);
       out << "],\n\"settings\": " << fit_options_to_json(o);
       if (inputs.size() > 1) out << ",\n\"rotations\": " << rotations_json().dump();
+      out << ",\n\"gemm\": " << gemm_record.dump();
       out << ",\n\"report\": {\"iteration\": " << trainer.iteration()
           << ", \"faults\": " << trainer.faults() << ", \"fault_actions\": [";
       for (size_t i = 0; i < trainer.fault_log().size(); ++i)
@@ -873,6 +930,11 @@ void add_fit(CLI::App& app) {
        "--threads", a->threads,
        "Threads (default: all cores; a resumed run keeps its own, as results depend on it)")
       ->check(CLI::Range(0, 1024));
+  c->add_option("--gemm", a->gemm,
+                "The float GEMMs' backend: auto (the faster here, measured once per machine and "
+                "kept in ~/.cache/jsatlas/gemm.json; Eigen where nothing can be kept), eigen, or "
+                "blas (default: auto; a resumed run keeps its own, as results depend on it)")
+      ->check(CLI::IsMember({"auto", "eigen", "blas"}));
   c->add_option("--w-6d", o.weights.surface, "lambda_6D on L_6D (Eq. 7)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber)

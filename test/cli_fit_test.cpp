@@ -299,3 +299,76 @@ TEST_CASE("cli: the schedule's flags are saved, collections keep M fixed, a shor
   CHECK(settings(dir + "_capped")["template_steps"] == 40);
   CHECK(settings(dir + "_capped")["template_max_steps"] == 40);
 }
+
+// --gemm (engine/gemm.h, model/tool/gemm_choice.h): the backend is a setting,
+// saved and resumed; a fixed one gives the same bits twice, here with a
+// collection's shapes split over two threads (each worker's products inside an
+// OpenMP team); a bad name is one line; `auto` without a cache (the tests'
+// JSATLAS_GEMM_CACHE=off) is Eigen unmeasured, with one it measures once and
+// then reads its answer.
+TEST_CASE(
+    "cli: --gemm is saved and resumed, gives the same losses twice, and auto keeps its choice",
+    "[cli][gemm]") {
+  const std::string dir = fresh_dir("gemm");
+  auto settings = [](const std::string& run) {
+    return nlohmann::json::parse(read_text(run + "/config.json"));
+  };
+  const std::string pair =
+      "fit builtin:sphere builtin:torus --iters 6 --template-steps 0 --no-align --code-size 8 -K "
+      "200 -M 200 --width 16 --depth 2 --threads 2 --pool 5000 --mesh-resolution 16 -q "
+      "--checkpoint-every 0 --gemm blas -o ";
+  Result r = run(pair + dir + "/a");
+  INFO(r.output);
+  if (r.code == 1 && r.output.find("built without a CBLAS") != std::string::npos) {
+    CHECK(count_lines(r.output) == 1);  // a build without the BLAS backend
+  } else {
+    REQUIRE(r.code == 0);
+    REQUIRE(run(pair + dir + "/b").code == 0);
+    CHECK(loss_rows(dir + "/a") == loss_rows(dir + "/b"));  // bit for bit
+    CHECK(settings(dir + "/a")["settings"]["gemm"] == "blas");
+    CHECK(settings(dir + "/a")["gemm"]["asked"] == "blas");
+    // Stopped and resumed: the checkpoint's backend, the same trajectory.
+    const std::string one = " --iters 8 --gemm blas" + kSmall;
+    REQUIRE(run("fit builtin:sphere -o " + dir + "/straight" + one).code == 0);
+    REQUIRE(run("fit builtin:sphere -o " + dir + "/stopped --stop-at 4" + one).code == 0);
+    r = run("fit --resume " + dir + "/stopped -q");
+    REQUIRE(r.code == 0);
+    CHECK(loss_rows(dir + "/stopped") == loss_rows(dir + "/straight"));
+    CHECK(settings(dir + "/stopped")["settings"]["gemm"] == "blas");
+    CHECK(settings(dir + "/stopped")["gemm"]["asked"] == "blas");  // the first record, kept
+  }
+  r = run("fit builtin:sphere -o " + dir + "/bad --gemm fast" + kSmall);
+  CHECK(r.code == 2);
+  CHECK(count_lines(r.output) == 1);
+  CHECK(r.output.find("--gemm") != std::string::npos);
+  // The default, auto, with no cache: Eigen, not measured, and said so.
+  const std::string quiet_off = kSmall.substr(0, kSmall.size() - 3) + " --iters 2";
+  r = run("fit builtin:sphere -o " + dir + "/auto" + quiet_off);
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  CHECK(r.output.find("fit: GEMMs by eigen: no cache") != std::string::npos);
+  CHECK(settings(dir + "/auto")["settings"]["gemm"] == "eigen");
+  CHECK(settings(dir + "/auto")["gemm"]["asked"] == "auto");
+  // With a cache (a file of this test's): measured by the first run, read by the second.
+  const std::string cache = dir + "/cache/gemm.json";
+  setenv("JSATLAS_GEMM_CACHE", cache.c_str(), 1);
+  const Result measured = run("fit builtin:sphere -o " + dir + "/measured" + quiet_off);
+  const Result cached = run("fit builtin:sphere -o " + dir + "/cached --gemm auto" + quiet_off);
+  unsetenv("JSATLAS_GEMM_CACHE");
+  INFO(measured.output << cached.output);
+  REQUIRE(measured.code == 0);
+  REQUIRE(cached.code == 0);
+  const nlohmann::json first = settings(dir + "/measured"), second = settings(dir + "/cached");
+  CHECK(first["settings"]["gemm"] == second["settings"]["gemm"]);
+  CHECK(loss_rows(dir + "/measured") == loss_rows(dir + "/cached"));  // the probe leaves no trace
+  if (first["gemm"]["blas"] != "") {
+    CHECK(first["gemm"]["source"] == "measured");
+    CHECK(first["gemm"]["eigen_ms"] > 0);
+    CHECK(first["gemm"]["blas_ms"] > 0);
+    CHECK(second["gemm"]["source"] == "cache");
+    CHECK(second["gemm"]["blas_ms"].get<double>() ==
+          Approx(first["gemm"]["blas_ms"].get<double>()));
+    CHECK(measured.output.find(", kept in " + cache) != std::string::npos);
+    CHECK(cached.output.find("from the cache " + cache) != std::string::npos);
+  }
+}

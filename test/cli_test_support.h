@@ -18,8 +18,12 @@ struct Result {
   std::string output;  // stdout and stderr together
 };
 
+// The cache of `fit --gemm auto` is off unless a test sets JSATLAS_GEMM_CACHE
+// itself (to a file of its own): no test writes the user's ~/.cache, run by
+// ctest (which sets it off too) or not.
 inline Result run(const std::string& args) {
-  const std::string cmd = std::string(JSATLAS_BINARY) + " " + args + " 2>&1";
+  const std::string cmd = "export JSATLAS_GEMM_CACHE=\"${JSATLAS_GEMM_CACHE:-off}\"; " +
+                          std::string(JSATLAS_BINARY) + " " + args + " 2>&1";
   Result r;
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;

@@ -121,6 +121,26 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   CHECK(legacy.atlas.softplus_beta == 0);
   CHECK(message_of(edited("\"batch_shapes\":0", "\"batch_shapes\":-2")) ==
         "run/model.ckpt: sizes must be positive");
+  // The GEMMs' backend (a later addition): kept both ways, a run from before
+  // it ran on Eigen, and a name other than the two is refused.
+  for (const jsa::Gemm g : {jsa::Gemm::eigen, jsa::Gemm::blas}) {
+    jsa::FitOptions p;
+    p.gemm = g;
+    CHECK(jsa::fit_options_from_json(jsa::fit_options_to_json(p), "x").gemm == g);
+  }
+  {
+    jsa::FitOptions p;
+    p.gemm = jsa::Gemm::blas;
+    std::string text = jsa::fit_options_to_json(p, -1);
+    const std::string key = ",\"gemm\":\"blas\"";
+    const auto at = text.find(key);
+    REQUIRE(at != std::string::npos);
+    CHECK(jsa::fit_options_from_json(text.erase(at, key.size()), "old").gemm == jsa::Gemm::eigen);
+  }
+  CHECK(message_of(edited("\"gemm\":\"eigen\"", "\"gemm\":\"fast\"")) ==
+        "run/model.ckpt: field 'gemm' must be \"eigen\" or \"blas\"");
+  CHECK(message_of(edited("\"gemm\":\"eigen\"", "\"gemm\":1")) ==
+        "run/model.ckpt: field 'gemm' has the wrong type");
   // Shapes split over threads (a later addition): kept both ways, and a run
   // from before it took one shape at a time.
   for (const bool split : {true, false}) {

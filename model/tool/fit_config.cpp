@@ -101,6 +101,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["parallel_shapes"] = o.parallel_shapes;
   j["pool"] = o.pool;
   j["threads"] = o.threads;
+  j["gemm"] = gemm_name(o.gemm);
   return j.dump(indent);
 }
 
@@ -243,6 +244,13 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
     throw InputError(what + ": template_steps must be >= -1 and template_share in [0, 1)");
   field(j, "", "pool", o.pool);
   field(j, "", "threads", o.threads);
+  o.gemm = Gemm::eigen;  // later addition: absent = Eigen, the only backend before it
+  if (j.contains("gemm")) {
+    std::string name;
+    field(j, "", "gemm", name);
+    if (!parse_gemm(name, &o.gemm))
+      throw InputError(what + ": field 'gemm' must be \"eigen\" or \"blas\"");
+  }
   if (o.atlas.gaussians <= 0 || o.atlas.width <= 0 || o.atlas.hidden_layers < 0 || o.points <= 0 ||
       o.atlas.shapes <= 0 || o.atlas.code_size <= 0 || o.pool <= 0 || o.threads < 0 ||
       o.orient_every < 0 || o.batch_shapes < 0 || o.wrap_steps < 0 || o.reseed_every < 0 ||

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "engine/adam.h"
+#include "engine/gemm.h"
 #include "model/heuristics/wrap.h"
 #include "model/objective.h"
 #include "model/tool/schedule.h"
@@ -66,6 +67,10 @@ struct FitOptions {
       0.5;  // each NaN/Inf recovery multiplies the learning rate by this for the rest of the run
   Index pool = 200000;  // surface samples drawn once per shape (the targets' pool)
   int threads = 0;      // threads of the run (0: all); results depend on seed and threads
+  // The float GEMMs' backend (engine/gemm.h); results depend on it too. Like
+  // `threads`, the caller applies it (set_gemm); `jsatlas fit --gemm auto`
+  // chooses it by measurement before training (model/tool/gemm_choice.h).
+  Gemm gemm = Gemm::eigen;
   // Every this many iterations before the first decay point, choose the global
   // orientation of phi (model/heuristics/orientation.h); 0: never. Only with normals in the loss.
   int orient_every = 100;

@@ -17,6 +17,9 @@
 # Usage: run_tests.sh MODE JSATLAS COMPARE MPIEXEC WORKDIR BOUND
 set -euo pipefail
 mode=$1 jsatlas=$2 compare=$3 mpiexec=$4 work=$5 bound=$6
+# No cache for `fit --gemm auto` (model/tool/gemm_choice.h): nothing written to
+# the user's home, and every run on Eigen, as the 1-process reference.
+export JSATLAS_GEMM_CACHE="${JSATLAS_GEMM_CACHE:-off}"
 mkdir -p "$work"
 cd "$work"
 printf 'builtin:sphere\nbuiltin:torus\nbuiltin:cube\nbuiltin:capsule\n' > shapes.txt
