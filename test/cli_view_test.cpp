@@ -51,7 +51,8 @@ long index_at(const nlohmann::json& packed, long k) {
 
 TEST_CASE("view: the page stands alone and carries the correspondences and keypoint errors") {
   const std::string dir = fresh_dir("cli_view");
-  REQUIRE(run("fit builtin:sphere builtin:torus -o " + dir + " --iters 6 --code-size 8" + kSmall)
+  REQUIRE(run("fit builtin:sphere builtin:torus -o " + dir + " --iters 6 --code-size 8 --no-align" +
+              kSmall)
               .code == 0);
   // Keypoints as SHREC gives them: <input stem>.vts, one vertex index per line.
   const long nv[2] = {long(jsa::builtin_shape("sphere").vertices.rows()),

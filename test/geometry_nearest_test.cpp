@@ -10,6 +10,7 @@
 #include "engine/parallel.h"
 #include "engine/rng.h"
 #include "io/geometry/nearest.h"
+#include "test/normal_draws.h"
 
 using namespace jsa;
 
@@ -29,7 +30,7 @@ Block<T> points_with_normals(Index n, uint64_t seed) {
   Rng rng(seed);
   Block<T> b(n, 6);
   for (Index i = 0; i < n; ++i) {
-    Eigen::Vector3d normal(rng.normal(), rng.normal(), rng.normal());
+    Eigen::Vector3d normal = test_support::normal_vector3(rng);
     normal = 0.01 * normal.normalized();
     for (int d = 0; d < 3; ++d) b(i, d) = T(rng.uniform(-1, 1));
     for (int d = 0; d < 3; ++d) b(i, 3 + d) = T(normal(d));

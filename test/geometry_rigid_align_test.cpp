@@ -5,6 +5,7 @@
 
 #include "engine/rng.h"
 #include "io/geometry/rigid_align.h"
+#include "test/normal_draws.h"
 
 namespace {
 
@@ -16,7 +17,7 @@ jsa::Block<double> lumpy(jsa::Index n, uint64_t seed) {
   jsa::Block<double> p(n, 3);
   const Eigen::RowVector3d bump = Eigen::RowVector3d(0.6, 0.5, 0.4).normalized();
   for (jsa::Index i = 0; i < n; ++i) {
-    Eigen::RowVector3d d(rng.normal(), rng.normal(), rng.normal());
+    Eigen::RowVector3d d = test_support::normal_vector3(rng).transpose();
     d.normalize();
     const double lift = 1 + 0.5 * std::exp(-8 * (d - bump).squaredNorm());
     // Per coordinate: GCC 12's -Warray-bounds misreads Eigen's AVX-512 row copy.
@@ -28,7 +29,7 @@ jsa::Block<double> lumpy(jsa::Index n, uint64_t seed) {
 }
 
 Eigen::Matrix3d random_rotation(jsa::Rng& rng) {
-  Eigen::Quaterniond q(rng.normal(), rng.normal(), rng.normal(), rng.normal());
+  Eigen::Quaterniond q = test_support::normal_quaternion(rng);
   q.normalize();
   return q.toRotationMatrix();
 }
@@ -82,7 +83,7 @@ TEST_CASE("close eigenvalues add the axis orders as candidates", "[model][rigid_
   auto round = [&](jsa::Index n) {
     jsa::Block<double> p(n, 3);
     for (jsa::Index i = 0; i < n; ++i) {
-      Eigen::RowVector3d d(rng.normal(), rng.normal(), rng.normal());
+      Eigen::RowVector3d d = test_support::normal_vector3(rng).transpose();
       d.normalize();
       const double lift = 1 + 0.4 * std::exp(-8 * (d - bump).squaredNorm());
       const double x[3] = {lift * d(0), lift * 0.97 * d(1), lift * 0.5 * d(2)};
@@ -110,7 +111,7 @@ TEST_CASE("a shape already in the pose of the first keeps it", "[model][rigid_al
   auto ellipsoid = [&](jsa::Index n) {
     jsa::Block<double> p(n, 3);
     for (jsa::Index i = 0; i < n; ++i) {
-      Eigen::RowVector3d d(rng.normal(), rng.normal(), rng.normal());
+      Eigen::RowVector3d d = test_support::normal_vector3(rng).transpose();
       d.normalize();
       const double x[3] = {d(0), 0.6 * d(1), 0.35 * d(2)};
       for (int k = 0; k < 3; ++k) p(i, k) = x[k];
@@ -173,7 +174,7 @@ TEST_CASE("a near-tie between poses goes to the one whose neighbourhoods match",
     jsa::Block<double> p(n, 3);
     dense.assign(size_t(n), 0);
     for (jsa::Index i = 0; i < n;) {
-      Eigen::RowVector3d d(rng.normal(), rng.normal(), rng.normal());
+      Eigen::RowVector3d d = test_support::normal_vector3(rng).transpose();
       d.normalize();
       if (d(0) < 0 && rng.uniform(0, 1) > 0.5) continue;
       const double s = d(0) > 0 ? dense_scale : 1.0;

@@ -9,6 +9,7 @@
 #include "engine/rng.h"
 #include "engine/tape.h"
 #include "losses/isometry.h"
+#include "test/normal_draws.h"
 
 using namespace jsa;
 
@@ -27,8 +28,7 @@ TEST_CASE("isometry_loss: 0 for an isometry (orthonormal J_u, J_v)", "[isometry]
   const Index m = 50;
   Block<double> du(m, 3), dv(m, 3);
   for (Index i = 0; i < m; ++i) {
-    Eigen::Vector3d a(rng.normal(), rng.normal(), rng.normal()),
-        b(rng.normal(), rng.normal(), rng.normal());
+    Eigen::Vector3d a = test_support::normal_vector3(rng), b = test_support::normal_vector3(rng);
     a.normalize();
     b = (b - b.dot(a) * a).normalized();
     du.row(i) = a.transpose();

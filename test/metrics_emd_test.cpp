@@ -14,6 +14,7 @@
 #include "losses/metrics/assignment.h"
 #include "losses/metrics/emd.h"
 #include "losses/metrics/metrics.h"
+#include "test/normal_draws.h"
 
 using namespace jsa;
 
@@ -29,7 +30,7 @@ OrientedPoints random_oriented(Index n, uint64_t seed) {
   OrientedPoints s{Block<double>(n, 3), Block<double>(n, 3)};
   for (Index i = 0; i < n; ++i) {
     for (int d = 0; d < 3; ++d) s.points(i, d) = rng.uniform(-1, 1);
-    Eigen::Vector3d normal(rng.normal(), rng.normal(), rng.normal());
+    Eigen::Vector3d normal = test_support::normal_vector3(rng);
     s.normals.row(i) = normal.normalized().transpose();
   }
   return s;

@@ -3,6 +3,7 @@
 #pragma once
 #include "engine/block.h"
 #include "engine/rng.h"
+#include "test/normal_draws.h"
 
 namespace test_support {
 
@@ -12,7 +13,7 @@ inline jsa::Block<double> sphere_pool(jsa::Index n, uint64_t seed, double s = 1.
   jsa::Rng rng(seed);
   jsa::Block<double> pool(n, 6);
   for (jsa::Index i = 0; i < n; ++i) {
-    Eigen::RowVector3d p(rng.normal(), rng.normal(), rng.normal());
+    Eigen::RowVector3d p = test_support::normal_vector3(rng).transpose();
     p.normalize();
     // Per coordinate: GCC 12 warns (-Warray-bounds) on Eigen's AVX-512 copy of a 3-vector row.
     for (int k = 0; k < 3; ++k) {

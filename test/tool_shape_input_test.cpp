@@ -4,6 +4,7 @@
 
 #include "engine/rng.h"
 #include "model/tool/shape_input.h"
+#include "test/normal_draws.h"
 
 using namespace jsa;
 
@@ -18,7 +19,7 @@ RunInput body(Index n, uint64_t seed, double bump_x) {
   in.pool.resize(n, 6);
   const Eigen::RowVector3d bump = Eigen::RowVector3d(bump_x, 0.5, 0.4).normalized();
   for (Index i = 0; i < n; ++i) {
-    Eigen::RowVector3d d(rng.normal(), rng.normal(), rng.normal());
+    Eigen::RowVector3d d = test_support::normal_vector3(rng).transpose();
     d.normalize();
     const double lift = 1 + 0.5 * std::exp(-8 * (d - bump).squaredNorm());
     const double x[3] = {lift * d(0), lift * 0.6 * d(1), lift * 0.35 * d(2)};
@@ -32,7 +33,7 @@ RunInput body(Index n, uint64_t seed, double bump_x) {
 }
 
 Eigen::Matrix3d random_rotation(Rng& rng) {
-  Eigen::Quaterniond q(rng.normal(), rng.normal(), rng.normal(), rng.normal());
+  Eigen::Quaterniond q = test_support::normal_quaternion(rng);
   q.normalize();
   return q.toRotationMatrix();
 }
