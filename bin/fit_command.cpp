@@ -91,6 +91,7 @@ auto with_flag_names(F&& f) {
       {"weights.repulsion", "--w-rep"},
       {"weights.code", "--w-code"},
       {"weights.metric", "--w-metric"},
+      {"weights.evenness", "--w-even"},
       {"weights.coverage", "--w-coverage"},
       {"metric_end", "--w-metric-end"},
       {"repulsion_tolerance", "--repulsion-tolerance"},
@@ -101,6 +102,7 @@ auto with_flag_names(F&& f) {
       {"template_max_steps", "--template-max-steps"},
       {"template_shape", "--template-shape"},
       {"chart_from", "--chart-from"},
+      {"evenness_from", "--w-even-from"},
       {"code_lr_scale", "--code-lr-scale"},
       {"surface_lr_scale", "--surface-lr-scale"},
       {"intrinsic", "--intrinsic"},
@@ -843,6 +845,13 @@ void add_fit(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber)
       ->check(kFinite);
+  c->add_option("--w-even", o.weights.evenness,
+                "lambda_even on L_even, the variance of log(P's density / phi's area element) "
+                "at the samples: phi(x_P) spread evenly over the surface (beyond the paper; "
+                "0: off; docs/results.md)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber)
+      ->check(kFinite);
   c->add_option("--w-metric-end", o.metric_end,
                 "Collections: lambda_metric moves geometrically from --w-metric at the first "
                 "joint step to this at the first learning-rate decay (-1: constant)")
@@ -1041,6 +1050,11 @@ void add_fit(CLI::App& app) {
   c->add_option("--intrinsic-until", o.intrinsic_until,
                 "With --intrinsic: the descriptors in the template start and this fraction of "
                 "--iters, then L_6D alone")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0))
+      ->check(kFinite);
+  c->add_option("--w-even-from", o.evenness_from,
+                "L_even (--w-even) from this fraction of --iters on (0: all along)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0))
       ->check(kFinite);

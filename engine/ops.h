@@ -3,7 +3,7 @@
 //   ops_linear.cpp      linear (X W + b), relu, relu_masked, softplus_stacked
 //                       (the last two on stacked tangents)
 //   ops_elementwise.cpp add/sub/mul (row broadcasting), scale, offset, square,
-//                       sqrt, exp
+//                       sqrt, exp, log
 //   ops_rows.cpp        concat/slice of columns and rows, gather rows by index
 //   ops_reduce.cpp      sum, mean, row_dot, row_norm, row_normalize, cross3
 // Shapes use one alphabet: N rows (points), C columns (channels).
@@ -55,6 +55,9 @@ template <class T>
 Var sqrt(Tape<T>& t, Var x, T eps = T(1e-12));
 template <class T>
 Var exp(Tape<T>& t, Var x);
+// The natural logarithm; x > 0 (the caller's floor: no eps here).
+template <class T>
+Var log(Tape<T>& t, Var x);
 
 // ---- rows and columns (ops_rows.cpp) ----
 template <class T>

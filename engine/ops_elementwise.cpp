@@ -170,6 +170,16 @@ Var exp(Tape<T>& t, Var x) {
   return y;
 }
 
+// y = log x (x > 0) ;  dx += dy / x
+template <class T>
+Var log(Tape<T>& t, Var x) {
+  Var y = t.node(t.rows(x), t.cols(x), {x});
+  t.value(y) = t.value(x).array().log();
+  t.on_backward(
+      y, [x](Tape<T>& t, Var y) { t.grad(x).array() += t.grad(y).array() / t.value(x).array(); });
+  return y;
+}
+
 #define JSA_INSTANTIATE(T)                  \
   template Var add<T>(Tape<T>&, Var, Var);  \
   template Var sub<T>(Tape<T>&, Var, Var);  \
@@ -178,7 +188,8 @@ Var exp(Tape<T>& t, Var x) {
   template Var offset<T>(Tape<T>&, Var, T); \
   template Var square<T>(Tape<T>&, Var);    \
   template Var sqrt<T>(Tape<T>&, Var, T);   \
-  template Var exp<T>(Tape<T>&, Var);
+  template Var exp<T>(Tape<T>&, Var);       \
+  template Var log<T>(Tape<T>&, Var);
 JSA_INSTANTIATE(float)
 JSA_INSTANTIATE(double)
 

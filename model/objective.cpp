@@ -6,6 +6,7 @@
 #include "engine/ops.h"
 #include "losses/chamfer.h"
 #include "losses/cycle.h"
+#include "losses/evenness.h"
 #include "losses/isometry.h"
 #include "losses/repulsion.h"
 
@@ -105,6 +106,14 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
     weighted.push_back({w.isometry, iso});
     out.isometry = double(t.scalar(iso));
   }
+  if (w.evenness > 0 && jacobian) {
+    // L_even on the Jacobian at {x_P} (beyond the paper; losses/evenness.h):
+    // P's density over the area element, as even as it can be.
+    const Var even = evenness_loss(t, x_p, p.on(t, atlas.domain.means()), atlas.domain.sigma(),
+                                   first_m(all.du), first_m(all.dv));
+    weighted.push_back({w.evenness, even});
+    out.evenness = double(t.scalar(even));
+  }
   if (w.metric > 0 && jacobian && o.metric_reference >= 0 && shape != o.metric_reference) {
     // L_metric (collections, beyond the paper; losses/isometry.h): the
     // reference shape's phi at this shape's {x_P}, its metric against ours.
@@ -166,6 +175,7 @@ Var objective_share(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>>& ta
     sum_terms.cycle_2d += one.cycle_2d;
     sum_terms.cycle_6d += one.cycle_6d;
     sum_terms.isometry += one.isometry;
+    sum_terms.evenness += one.evenness;
   }
   // A subset of B shapes stands for all N: its sum is scaled by N / B (see collection_objective).
   if (b > 0 && share.batch < n) total = scale(t, total, T(double(n) / double(share.batch)));
@@ -229,8 +239,8 @@ Var collection_objective(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>
   const Var total = objective_share(t, atlas, targets, m, o, share, &sums);
   if (terms) {
     *terms = sums;
-    for (double* v :
-         {&terms->surface, &terms->chart, &terms->cycle_2d, &terms->cycle_6d, &terms->isometry})
+    for (double* v : {&terms->surface, &terms->chart, &terms->cycle_2d, &terms->cycle_6d,
+                      &terms->isometry, &terms->evenness})
       *v /= b;
   }
   return total;

@@ -23,6 +23,7 @@ struct LossWeights {
   double repulsion = 1.0;  // l_rep, on L_rep (Eq. 11)
   double code = 1e-4;      // collections: weight of the mean squared norm of the latent codes
   double metric = 0;       // collections: on L_metric (beyond the paper; losses/isometry.h)
+  double evenness = 0;     // on L_even, samples spread evenly (beyond the paper; losses/evenness.h)
   // Inside L_6D: the weight of its coverage direction (each target's distance
   // to the nearest phi6(x_P)) against its accuracy direction; 1 is Eq. 6.
   double coverage = 1.0;
@@ -42,6 +43,7 @@ struct Components {
 // The value of each term at the last evaluation (unweighted), and the total.
 struct LossTerms {
   double total = 0, surface = 0, chart = 0, cycle_2d = 0, cycle_6d = 0, isometry = 0, repulsion = 0;
+  double evenness = 0;  // 0 when l_even is 0 (not computed)
 };
 
 struct ObjectiveOptions {

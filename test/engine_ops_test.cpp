@@ -77,6 +77,9 @@ std::vector<GradCase> op_cases() {
   add_case("sqrt", [](T& t, const Vs& x) { return sqrt(t, x[0]); },
            {uniform_block(rng, n, c, 0.5, 2.0)});
   add_case("exp", [](T& t, const Vs& x) { return exp(t, x[0]); }, {signed_block(rng, n, c)});
+  // x in [0.2, 2): away from log's pole at 0.
+  add_case("log", [](T& t, const Vs& x) { return log(t, x[0]); },
+           {uniform_block(rng, n, c, 0.2, 2.0)});
 
   // ---- rows and columns ----
   add_case("concat_cols", [](T& t, const Vs& x) { return concat_cols(t, x); },

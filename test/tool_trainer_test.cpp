@@ -496,6 +496,27 @@ TEST_CASE("trainer: chart_from trains phi and P alone until that fraction of the
   CHECK(t.last().chart > 0);
 }
 
+TEST_CASE("trainer: L_even from evenness_from of the run; until then the run without it",
+          "[trainer]") {
+  FitOptions o = small_options();
+  o.iterations = 6;
+  FitOptions even = o;
+  even.weights.evenness = 1e-2;
+  even.evenness_from = 0.5;
+  Trainer plain(o, sphere_pool(4000, 1)), staged(even, sphere_pool(4000, 1));
+  for (int i = 0; i < 3; ++i) {
+    plain.step();
+    staged.step();
+    CHECK(staged.last().evenness == 0);
+    CHECK(staged.last().total == plain.last().total);  // the same run, bit for bit
+  }
+  plain.step();  // from iteration 3: L_even in the loss
+  staged.step();
+  CHECK(staged.last().evenness > 0);
+  CHECK(staged.last().total ==
+        Approx(plain.last().total + 1e-2 * staged.last().evenness).epsilon(1e-5));
+}
+
 TEST_CASE("medoid_shape: the shape between the others is the template", "[trainer]") {
   // Spheres of radius 1.0, 1.2 and 1.1: the middle one (index 2) is closest
   // to both others, whatever the order; identical sets tie to the lowest index.

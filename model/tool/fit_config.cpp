@@ -59,6 +59,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
                   {"repulsion", o.weights.repulsion},
                   {"code", o.weights.code},
                   {"metric", o.weights.metric},
+                  {"evenness", o.weights.evenness},
                   {"coverage", o.weights.coverage},
                   {"convention", "mean over points (paper's 1/M factors folded in)"}};
   j["components"] = {{"normals", o.components.normals},
@@ -92,6 +93,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["template_share"] = o.template_share;
   j["template_max_steps"] = o.template_max_steps;
   j["chart_from"] = o.chart_from;
+  j["evenness_from"] = o.evenness_from;
   j["metric_end"] = o.metric_end;
   j["metric_conformal"] = o.metric_conformal;
   j["code_lr_scale"] = o.code_lr_scale;
@@ -151,6 +153,10 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   field(w, "weights.", "code", o.weights.code);
   o.weights.metric = 0;  // later addition: absent = off, what older runs used
   if (w.contains("metric")) field(w, "weights.", "metric", o.weights.metric);
+  o.weights.evenness = 0;  // later addition: absent = off
+  if (w.contains("evenness")) field(w, "weights.", "evenness", o.weights.evenness);
+  if (!(o.weights.evenness >= 0) || !std::isfinite(o.weights.evenness))
+    throw InputError(what + ": weights.evenness must be finite and >= 0");
   o.weights.coverage = 1;  // later addition: absent = Eq. 6's equal directions
   if (w.contains("coverage")) field(w, "weights.", "coverage", o.weights.coverage);
   if (!(o.weights.coverage >= 0) || !std::isfinite(o.weights.coverage))
@@ -237,6 +243,10 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (j.contains("chart_from")) field(j, "", "chart_from", o.chart_from);
   if (!(o.chart_from >= 0 && o.chart_from <= 1))
     throw InputError(what + ": chart_from must be in [0, 1]");
+  o.evenness_from = 0;  // later addition: absent = all along
+  if (j.contains("evenness_from")) field(j, "", "evenness_from", o.evenness_from);
+  if (!(o.evenness_from >= 0 && o.evenness_from <= 1))
+    throw InputError(what + ": evenness_from must be in [0, 1]");
   o.template_max_steps = 0;  // later addition: absent = no cap
   if (j.contains("template_max_steps")) field(j, "", "template_max_steps", o.template_max_steps);
   if (o.template_max_steps < 0) throw InputError(what + ": template_max_steps must be >= 0");

@@ -38,7 +38,8 @@ static void validate(const FitOptions& o) {
       {o.weights.isometry, "weights.isometry must be >= 0 and finite"},
       {o.weights.repulsion, "weights.repulsion must be >= 0 and finite"},
       {o.weights.code, "weights.code must be >= 0 and finite"},
-      {o.weights.metric, "weights.metric must be >= 0 and finite"}};
+      {o.weights.metric, "weights.metric must be >= 0 and finite"},
+      {o.weights.evenness, "weights.evenness must be >= 0 and finite"}};
   for (const auto& [w, message] : weights) require(w >= 0 && std::isfinite(w), message);
   require(o.repulsion_tolerance > 0, "repulsion_tolerance must be positive");
   require(o.orient_every >= 0 && o.reseed_every >= 0 && o.wrap_steps >= 0,
@@ -48,6 +49,7 @@ static void validate(const FitOptions& o) {
   require(o.template_steps >= -1, "template_steps must be >= -1");
   require(o.template_share >= 0 && o.template_share < 1, "template_share must be in [0, 1)");
   require(o.chart_from >= 0 && o.chart_from <= 1, "chart_from must be in [0, 1]");
+  require(o.evenness_from >= 0 && o.evenness_from <= 1, "evenness_from must be in [0, 1]");
   require(std::isfinite(o.metric_end), "metric_end must be finite (< 0: lambda_metric constant)");
   require(o.code_lr_scale > 0 && std::isfinite(o.code_lr_scale),
           "code_lr_scale must be positive and finite");
@@ -383,6 +385,8 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
   // The staged objective (FitOptions::chart_from): phi and P alone at first.
   if (double(iteration_) < options_.chart_from * double(options_.iterations))
     objective.components.chart = false;
+  if (double(iteration_) < options_.evenness_from * double(options_.iterations))
+    objective.weights.evenness = 0;
 
   // L_full is a sum over shapes (Eq. 12), so its gradient is too: the step's
   // shapes are split into `workers` consecutive groups, each group's share of
@@ -460,6 +464,7 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
     sums.cycle_6d += p.cycle_6d;
     sums.isometry += p.isometry;
     sums.repulsion += p.repulsion;
+    sums.evenness += p.evenness;
   }
   // The test hook counts joint iterations only (the template start has none).
   if (!template_step && counter == fault_at_ && faults_to_inject_ > 0) {
@@ -472,8 +477,8 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
   // Inf, every rank takes the same recovery below, from the same snapshot.
   if (team_ && team_->size() > 1) finite = exchange(sums, finite);
   last_ = sums;
-  for (double* v :
-       {&last_.surface, &last_.chart, &last_.cycle_2d, &last_.cycle_6d, &last_.isometry})
+  for (double* v : {&last_.surface, &last_.chart, &last_.cycle_2d, &last_.cycle_6d, &last_.isometry,
+                    &last_.evenness})
     *v /= b;
   report.terms = last_;
   // Template steps and joint iterations in one increasing count: the template

@@ -114,6 +114,9 @@ struct FitOptions {
   // alone (no psi, no L_2D, no L_cycle; Table 1 row 9's objective), then the
   // full method. 0: the full method from the start, as the paper.
   double chart_from = 0;
+  // L_even (weights.evenness, losses/evenness.h) from this fraction of the
+  // iterations on: the surface first, then its samples spread evenly. 0: all along.
+  double evenness_from = 0;
   // Collections: the latent codes' learning rate as a multiple of the networks'
   // (a per-group rate: the codes' Adam steps are scaled by it). 1: one rate.
   double code_lr_scale = 1;
@@ -168,6 +171,7 @@ inline void apply_paper_method(FitOptions& o) {
   o.orient_every = 0;
   o.weights.cycle = LossWeights{}.cycle;  // the paper's lambda_cycle (mean convention)
   o.weights.metric = 0;                   // not in the paper
+  o.weights.evenness = 0;                 // nor this
   o.schedule.kind = "step";               // and at a fixed M from the first step
   o.template_steps = 0;                   // the paper trains all shapes jointly from the start
   o.template_shape = 0;
