@@ -59,6 +59,7 @@ struct FitArgs {
   // Whether --iters and --schedule were given: collections and --preset paper
   // have defaults of their own (kFixedScheduleIterations in model/tool/trainer.h).
   bool iters_given = false, schedule_given = false;
+  bool even_given = false;  // --w-even
   bool points_given = false, gaussians_given = false, width_given = false, deform_given = false;
 };
 
@@ -239,6 +240,9 @@ void run_fit(FitArgs& a, Team& team) {
     const bool fixed_m = inputs.size() > 1 || !a.preset.empty();
     if (fixed_m && !a.schedule_given) o.schedule.kind = "step";
     if (fixed_m && !a.iters_given) o.iterations = kFixedScheduleIterations;
+    // L_even was measured on single shapes (docs/results.md); a collection
+    // keeps the objective its rounds were measured with unless told.
+    if (inputs.size() > 1 && !a.even_given) o.weights.evenness = 0;
     if (inputs.size() > 1 && a.preset.empty()) {  // trainer.h: sized for a laptop's minutes
       if (!a.points_given) o.points = kCollectionPoints;
       if (!a.gaussians_given) o.atlas.gaussians = kCollectionGaussians;
@@ -1133,6 +1137,7 @@ void add_fit(CLI::App& app) {
     a->gaussians_given = c->count("--gaussians") > 0;
     a->width_given = c->count("--width") > 0;
     a->deform_given = c->count("--deform-layers") > 0;
+    a->even_given = c->count("--w-even") > 0;
     std::unique_ptr<Team> team = join_team();
     if (team->size() == 1) return run_fit(*a, *team);
     try {

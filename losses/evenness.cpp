@@ -12,12 +12,12 @@
 // means' bounding box still sees every mean within r_c of it).
 #include "losses/evenness.h"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <memory>
 #include <vector>
-
-#include <omp.h>
 
 #include "engine/ops.h"
 #include "engine/parallel.h"
@@ -181,8 +181,8 @@ Var mixture_log_density(Tape<T>& t, Var x, Var mu, T sigma, const MixtureDensity
     Shares& part = parts[size_t(id)];
     for (Index n = begin; n < end; ++n) {
       part.begin.push_back(Index(part.mean.size()));
-      l(n, 0) = T(gather_shares(mv, grid, inv_2s2, r2, min_sum, double(xv(n, 0)),
-                                double(xv(n, 1)), part.mean, part.r));
+      l(n, 0) = T(gather_shares(mv, grid, inv_2s2, r2, min_sum, double(xv(n, 0)), double(xv(n, 1)),
+                                part.mean, part.r));
     }
   }
   auto shares = std::make_shared<Shares>();

@@ -277,6 +277,7 @@ TEST_CASE("cli: the schedule's flags are saved, collections keep M fixed, a shor
   REQUIRE(r.code == 0);
   CHECK(settings(dir + "_pair")["schedule"]["kind"] == "step");
   CHECK(settings(dir + "_pair")["iterations"] == 5000);
+  CHECK(settings(dir + "_pair")["weights"]["evenness"] == 0);  // L_even: single shapes only
   r = run("fit builtin:sphere builtin:torus -o " + dir +
           "_pair_ramp --stop-at 1 --template-steps 0 --no-align --schedule ramp --iters 30" +
           kSmall);
@@ -294,6 +295,8 @@ TEST_CASE("cli: the schedule's flags are saved, collections keep M fixed, a shor
   INFO(r.output);
   REQUIRE(r.code == 0);
   CHECK(settings(dir + "_budget")["iterations"] > 25);
+  CHECK(settings(dir + "_budget")["weights"]["evenness"] == 0.01);  // the single-shape default
+  CHECK(settings(dir + "_budget")["evenness_from"] == 0.5);
   // Under --minutes the template start takes its share of the time, but no
   // more than --template-max-steps; the joint training gets the rest. (1.8 s
   // of template time for 40 steps of these tiny networks: a wide margin.)
