@@ -295,7 +295,7 @@ TEST_CASE("cli: the schedule's flags are saved, collections keep M fixed, a shor
   INFO(r.output);
   REQUIRE(r.code == 0);
   CHECK(settings(dir + "_budget")["iterations"] > 25);
-  CHECK(settings(dir + "_budget")["weights"]["evenness"] == 0.01);  // the single-shape default
+  CHECK(settings(dir + "_budget")["weights"]["evenness"] == 0.003);  // the single-shape default
   CHECK(settings(dir + "_budget")["evenness_from"] == 0.5);
   // Under --minutes the template start takes its share of the time, but no
   // more than --template-max-steps; the joint training gets the rest. (1.8 s
