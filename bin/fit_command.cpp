@@ -31,6 +31,7 @@
 #include "model/tool/mpi/mpi_team.h"
 #include "model/tool/pose_by_fit.h"
 #include "model/tool/shape_input.h"
+#include "model/tool/spectral_start.h"
 
 namespace jsa::cli {
 namespace {
@@ -108,6 +109,8 @@ auto with_flag_names(F&& f) {
       {"surface_lr_scale", "--surface-lr-scale"},
       {"intrinsic", "--intrinsic"},
       {"intrinsic_until", "--intrinsic-until"},
+      {"spectral_map", "--spectral-map"},
+      {"spectral_map_until", "--spectral-map-until"},
       {"schedule.kind", "--schedule"},
       {"schedule.points_start", "--points-start"},
       {"schedule.ramp_until", "--ramp-until"},
@@ -251,6 +254,8 @@ void run_fit(FitArgs& a, Team& team) {
     }
     if (o.intrinsic > 0 && inputs.size() < 2)
       throw InputError("--intrinsic: needs a collection (two or more inputs)");
+    if (o.spectral_map > 0 && inputs.size() < 2)
+      throw InputError("--spectral-map: needs a collection (two or more inputs)");
     if (o.atlas.deform_domain && (inputs.size() < 2 || o.atlas.deform_layers == 0))
       throw InputError(
           "--deform-domain: needs a collection (two or more inputs) with --deform-layers > 0");
@@ -482,6 +487,22 @@ void run_fit(FitArgs& a, Team& team) {
     }
   }
   Trainer trainer = make_trainer(o, pools, &team);
+  if (o.spectral_map > 0) {
+    // L_map's maps (model/tool/spectral_start.h), from the meshes in their
+    // fit's frames; a resumed run finds the same ones (they depend on nothing else).
+    if (many) throw InputError("--spectral-map: not over MPI yet");
+    const auto s0 = std::chrono::steady_clock::now();
+    std::vector<Mesh> meshes;
+    for (const RunInput& s : shapes) meshes.push_back(s.mesh);
+    const SpectralStart start = spectral_start(meshes, frames, o.template_shape);
+    trainer.set_spectral_map(start.template_vertices, start.images);
+    const double took =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();
+    pose_fit_seconds += took;  // counted against --minutes, as the pose step
+    if (!a.quiet)
+      std::cerr << "fit: spectral maps from the template (shape " << o.template_shape
+                << ") to the others in " << format_duration(took) << "\n";
+  }
   LossLog log;
   if (resuming) {
     restore_trainer(trainer, resumed, a.resume);
@@ -1054,6 +1075,19 @@ void add_fit(CLI::App& app) {
   c->add_option("--intrinsic-until", o.intrinsic_until,
                 "With --intrinsic: the descriptors in the template start and this fraction of "
                 "--iters, then L_6D alone")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0))
+      ->check(kFinite);
+  c->add_option(
+       "--spectral-map", o.spectral_map,
+       "Collections of meshes: lambda_map, the pull of each shape towards the image of "
+       "the template under a map between their Laplace-Beltrami eigenfunctions (ZoomOut), "
+       "which an arm's pose does not change; fades to 0 over --spectral-map-until (0: off)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e3))
+      ->check(kFinite);
+  c->add_option("--spectral-map-until", o.spectral_map_until,
+                "With --spectral-map: the fraction of --iters over which lambda_map falls to 0")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0))
       ->check(kFinite);

@@ -26,7 +26,8 @@ Components Components::table_row(int row) {
 template <class T>
 Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T>& targets, Index m,
                            Rng& rng, const ObjectiveOptions& o, LossTerms* terms,
-                           const NearestIndex<T>* dense, const IntrinsicField<T>* intrinsic) {
+                           const NearestIndex<T>* dense, const IntrinsicField<T>* intrinsic,
+                           const MapField<T>* map) {
   const LossWeights& w = o.weights;
   const Components& c = o.components;
   JSA_CHECK(targets.cols() == (intrinsic ? 9 : 6),
@@ -128,6 +129,23 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
             : metric_mismatch(t, first_m(all.du), first_m(all.dv), ref.du, ref.dv);
     weighted.push_back({w.metric, metric});
   }
+  if (w.map > 0 && map && shape != map->reference) {
+    // L_map (objective.h): T_i(phi_t(x_P)) a constant of the step, phi_t on
+    // the values alone (as L_6D^h's h_t above).
+    const Var x_fixed = t.constant(Block<T>(t.value(x_p)));
+    const Var code_t = atlas.has_codes()
+                           ? t.constant(Block<T>(t.value(atlas.phi_code(t, map->reference))))
+                           : Var{};
+    const SurfacePoints on_t = atlas.phi.evaluate(t, p, x_fixed, false, code_t);
+    std::vector<int> near;
+    map->surface->query(t.value(on_t.points), near);
+    const Block<T>& image = (*map->images)[size_t(shape)];
+    Block<T> y(m, 3);
+    for (Index i = 0; i < m; ++i) y.row(i) = image.row(near[size_t(i)]);
+    const Var pull = mean_squared_distance(t, first_m(all.points), t.constant(y));
+    weighted.push_back({w.map, pull});
+    out.map = double(t.scalar(pull));
+  }
   if (c.repulsion) {
     // L_rep on the means   (Eq. 11)
     const Var rep = repulsion(t, p.on(t, atlas.domain.means()), atlas.domain.sigma(),
@@ -168,7 +186,7 @@ Var objective_share(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>>& ta
     const NearestIndex<T>* dense = share.surfaces.empty() ? nullptr : share.surfaces[size_t(k)];
     const Var l =
         single_shape_objective(t, atlas, shape, targets[size_t(k)], m, *share.rngs[size_t(k)],
-                               per_shape, &one, dense, share.intrinsic);
+                               per_shape, &one, dense, share.intrinsic, share.map);
     total = k == 0 ? l : add(t, total, l);
     sum_terms.surface += one.surface;
     sum_terms.chart += one.chart;
@@ -176,6 +194,7 @@ Var objective_share(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>>& ta
     sum_terms.cycle_6d += one.cycle_6d;
     sum_terms.isometry += one.isometry;
     sum_terms.evenness += one.evenness;
+    sum_terms.map += one.map;
   }
   // A subset of B shapes stands for all N: its sum is scaled by N / B (see collection_objective).
   if (b > 0 && share.batch < n) total = scale(t, total, T(double(n) / double(share.batch)));
@@ -240,20 +259,20 @@ Var collection_objective(Tape<T>& t, Atlas<T>& atlas, const std::vector<Block<T>
   if (terms) {
     *terms = sums;
     for (double* v : {&terms->surface, &terms->chart, &terms->cycle_2d, &terms->cycle_6d,
-                      &terms->isometry, &terms->evenness})
+                      &terms->isometry, &terms->evenness, &terms->map})
       *v /= b;
   }
   return total;
 }
 
-#define JSA_INSTANTIATE(T)                                                                       \
-  template Var single_shape_objective<T>(Tape<T>&, Atlas<T>&, int, const Block<T>&, Index, Rng&, \
-                                         const ObjectiveOptions&, LossTerms*,                    \
-                                         const NearestIndex<T>*, const IntrinsicField<T>*);      \
-  template Var collection_objective<T>(                                                          \
-      Tape<T>&, Atlas<T>&, const std::vector<Block<T>>&, Index, Rng&, const ObjectiveOptions&,   \
-      LossTerms*, const std::vector<int>&, const std::vector<NearestIndex<T>>&);                 \
-  template Var objective_share<T>(Tape<T>&, Atlas<T>&, const std::vector<Block<T>>&, Index,      \
+#define JSA_INSTANTIATE(T)                                                                         \
+  template Var single_shape_objective<T>(                                                          \
+      Tape<T>&, Atlas<T>&, int, const Block<T>&, Index, Rng&, const ObjectiveOptions&, LossTerms*, \
+      const NearestIndex<T>*, const IntrinsicField<T>*, const MapField<T>*);                       \
+  template Var collection_objective<T>(                                                            \
+      Tape<T>&, Atlas<T>&, const std::vector<Block<T>>&, Index, Rng&, const ObjectiveOptions&,     \
+      LossTerms*, const std::vector<int>&, const std::vector<NearestIndex<T>>&);                   \
+  template Var objective_share<T>(Tape<T>&, Atlas<T>&, const std::vector<Block<T>>&, Index,        \
                                   const ObjectiveOptions&, const ObjectiveShare<T>&, LossTerms*);
 JSA_INSTANTIATE(float)
 JSA_INSTANTIATE(double)

@@ -24,6 +24,7 @@ struct LossWeights {
   double code = 1e-4;      // collections: weight of the mean squared norm of the latent codes
   double metric = 0;       // collections: on L_metric (beyond the paper; losses/isometry.h)
   double evenness = 0;     // on L_even, samples spread evenly (beyond the paper; losses/evenness.h)
+  double map = 0;          // collections: on L_map, the pull of a spectral map (MapField below)
   // Inside L_6D: the weight of its coverage direction (each target's distance
   // to the nearest phi6(x_P)) against its accuracy direction; 1 is Eq. 6.
   double coverage = 1.0;
@@ -44,6 +45,7 @@ struct Components {
 struct LossTerms {
   double total = 0, surface = 0, chart = 0, cycle_2d = 0, cycle_6d = 0, isometry = 0, repulsion = 0;
   double evenness = 0;  // 0 when l_even is 0 (not computed)
+  double map = 0;       // L_map; 0 when off
 };
 
 struct ObjectiveOptions {
@@ -77,6 +79,26 @@ struct IntrinsicField {
   const Block<T>* descriptors = nullptr;     // beta h_t at those samples
 };
 
+// Beyond the paper (issue 19, docs/collections.md, "A spectral map as the
+// layouts' start"): a vertex-to-vertex map T_i from the template t to each shape
+// i, found before training by ZoomOut on the shapes' Laplace-Beltrami
+// eigenfunctions (io/geometry/functional_map.h), which do not change when an
+// arm bends. L_map asks shape i to put each domain point where T_i sends the
+// template's point there:
+//
+//   L_map = (1/M) sum_m | phi_i(x_m) - T_i(phi_t(x_m)) |^2
+//
+// with T_i(y) the image of t's vertex nearest to y: a constant of the step, as
+// h_t in L_6D^h. It decides, at the start, which part of each shape a part of
+// the domain covers; the Chamfer terms then finish the surfaces (the trainer
+// fades its weight to 0, FitOptions::spectral_map_until).
+template <class T>
+struct MapField {
+  int reference = 0;                              // t
+  const NearestIndex<T>* surface = nullptr;       // t's vertices (unit frame)
+  const std::vector<Block<T>>* images = nullptr;  // per shape i: T_i of each of t's vertices
+};
+
 // Builds L_single of shape `shape` (0 for a single shape) on the tape and returns
 // it (1 x 1). targets: rows [x_S, alpha n_S] sampled on the shape; `samples` 2D
 // points are drawn from P. surface: if given, L_6D is the dense variant (see
@@ -87,7 +109,8 @@ template <class T>
 Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T>& targets,
                            Index samples, Rng& rng, const ObjectiveOptions& o, LossTerms* terms,
                            const NearestIndex<T>* surface = nullptr,
-                           const IntrinsicField<T>* intrinsic = nullptr);
+                           const IntrinsicField<T>* intrinsic = nullptr,
+                           const MapField<T>* map = nullptr);
 
 // L_full, Eq. (12): sum over the shapes of L_single. L_rep depends on mu alone,
 // so it is computed once and counted N times (as the sum does); a collection
@@ -114,6 +137,7 @@ struct ObjectiveShare {
   std::vector<Rng*> rngs;                        // per target set: the draws of x_P
   std::vector<const NearestIndex<T>*> surfaces;  // empty, or per target set (dense L_6D)
   const IntrinsicField<T>* intrinsic = nullptr;  // L_6D^h (targets M x 9), or L_6D
+  const MapField<T>* map = nullptr;              // L_map (weights.map > 0), or none
   int batch = 0;                     // B: the step's shapes over all shares (scale N / B)
   bool repulsion = true;             // this share adds N l_rep L_rep
   int code_begin = 0, code_end = 0;  // this share adds the prior of codes [begin, end)

@@ -108,4 +108,7 @@ TEST_CASE("cli: flag values out of range are refused before any work", "[cli]") 
   rejects(fit + "--deform-domain", 1, "--deform-domain: needs a collection");
   rejects(fit + "--intrinsic -0.5", 2, "--intrinsic");
   rejects(fit + "--intrinsic 0.5", 1, "--intrinsic: needs a collection");
+  rejects(fit + "--spectral-map -1", 2, "--spectral-map");
+  rejects(fit + "--spectral-map-until 1.5", 2, "--spectral-map-until");
+  rejects(fit + "--spectral-map 1", 1, "--spectral-map: needs a collection");
 }

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <csignal>
 #include <nlohmann/json.hpp>
 #include <thread>
@@ -159,6 +160,33 @@ TEST_CASE(
     CHECK(same_order);
     CHECK(uv_in_range);
   }
+}
+
+TEST_CASE("cli: --spectral-map fits a collection of meshes and refuses a point cloud", "[cli]") {
+  const std::string dir = fresh_dir("spectral_map");
+  Result r = run("fit builtin:sphere builtin:capsule -o " + dir +
+                 " --iters 6 --template-steps 4 --spectral-map 2 --code-size 8" + kSmall);
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  CHECK(read_text(dir + "/config.json").find("\"spectral_map\": 2.0") != std::string::npos);
+  CHECK(fs::exists(dir + "/model.ckpt"));
+  // Points alone have no Laplace-Beltrami basis here: one line, before any training.
+  std::string cloud;
+  for (int i = 0; i < 200; ++i) {
+    // A point of the unit sphere, twice: as the point and as its normal.
+    const double a = 0.1 * i, b = 0.37 * i;
+    const std::string p = std::to_string(std::cos(a) * std::sin(b)) + " " +
+                          std::to_string(std::sin(a) * std::sin(b)) + " " +
+                          std::to_string(std::cos(b));
+    cloud += p + " " + p + "\n";
+  }
+  write_text(dir + "/cloud.xyz", cloud);
+  const std::string other = fresh_dir("spectral_map_cloud");
+  r = run("fit builtin:sphere " + dir + "/cloud.xyz -o " + other +
+          " --iters 2 --spectral-map 1 --code-size 8" + kSmall);
+  CHECK(r.code == 1);
+  CHECK(r.output.find("--spectral-map needs triangle meshes") != std::string::npos);
+  CHECK(!fs::exists(other + "/model.ckpt"));
 }
 
 TEST_CASE(

@@ -559,3 +559,80 @@ TEST_CASE("objective: L_6D^h, descriptors appended to L_6D (intrinsic)", "[objec
   CHECK_THROWS(intrinsic_share_value(atlas, six, &on, tape, false));
   CHECK_THROWS(intrinsic_share_value(atlas, targets, nullptr, tape, false));
 }
+
+namespace {
+
+// One share of both shapes with L_map (model/objective.h) at weight w.
+double map_share_value(Atlas<double>& atlas, const std::vector<Block<double>>& targets,
+                       const MapField<double>* field, double w, Tape<double>& tape, bool backward,
+                       LossTerms* terms = nullptr) {
+  std::vector<Rng> rngs{Rng(99, 0), Rng(99, 1)};
+  ObjectiveShare<double> share;
+  share.shapes = {0, 1};
+  share.rngs = {&rngs[0], &rngs[1]};
+  share.batch = 2;
+  share.code_end = 2;
+  share.map = field;
+  ObjectiveOptions o;
+  o.weights.map = w;
+  tape.clear();
+  Var loss = objective_share(tape, atlas, targets, 24, o, share, terms);
+  if (backward) {
+    atlas.params.zero_grad();
+    tape.backward(loss);
+  }
+  return tape.scalar(loss);
+}
+
+}  // namespace
+
+TEST_CASE("objective: L_map, the pull towards a spectral map's image", "[objective]") {
+  AtlasOptions ao = small_atlas_options();
+  ao.shapes = 2;
+  ao.code_size = 4;
+  ao.deform_layers = 2;
+  ao.softplus_beta = 10;
+  Atlas<double> atlas(ao);
+  Rng init(6);
+  atlas.initialize(init);
+  for (const char* name : {"phi.deform.w2", "phi.deform.b2"})
+    atlas.params.value(atlas.params.find(name)) *= 100.0;
+  const std::vector<Block<double>> targets{random_targets(32, ao.alpha, 3),
+                                           random_targets(32, ao.alpha, 4)};
+  // The template is shape 1; its "vertices" and, for shape 0, their images:
+  // the template's points moved by a fixed affine map.
+  const Block<double> vertices = random_targets(400, ao.alpha, 7).leftCols(3);
+  Block<double> moved = (vertices * 1.2).rowwise() + Eigen::RowVector3d(0.1, -0.2, 0.05);
+  const std::vector<Block<double>> images{moved, Block<double>(0, 3)};
+  const NearestIndex<double> surface(vertices);
+  const MapField<double> field{1, &surface, &images};
+  Tape<double> tape;
+
+  // Weight 0, or no field: the objective without L_map.
+  const double plain = map_share_value(atlas, targets, nullptr, 0, tape, false);
+  CHECK(map_share_value(atlas, targets, &field, 0, tape, false) == Approx(plain).epsilon(1e-12));
+  CHECK(map_share_value(atlas, targets, nullptr, 0.7, tape, false) == Approx(plain).epsilon(1e-12));
+
+  // Weight 0.7: the total grows by 0.7 L_map of shape 0 alone (the template
+  // carries no term), and every block's gradient matches central differences
+  // (T_i(phi_t(x)) is piecewise constant: small steps keep its look-ups).
+  LossTerms terms;
+  const double value = map_share_value(atlas, targets, &field, 0.7, tape, true, &terms);
+  CHECK(terms.map > 1e-3);
+  // A share's terms are summed over its shapes; only shape 0 has L_map.
+  CHECK(value - plain == Approx(0.7 * terms.map).epsilon(1e-9));
+  const std::vector<double> analytic = atlas.params.grads();
+  int checked = 0;
+  double worst = 0;
+  for (const char* name : {"codes.phi", "phi.deform.w0", "phi.w0", "phi.w2", "domain.mu"}) {
+    const auto& e = atlas.params.entry(atlas.params.find(name));
+    worst = std::max(
+        worst,
+        worst_central_difference(
+            atlas, analytic, e.offset, e.offset + size_t(e.rows * e.cols), 3,
+            [&]() { return map_share_value(atlas, targets, &field, 0.7, tape, false); }, checked));
+  }
+  INFO(checked << " entries, worst error/tolerance " << worst);
+  CHECK(checked > 30);
+  CHECK(worst <= 1.0);
+}

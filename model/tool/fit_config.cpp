@@ -100,6 +100,8 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["surface_lr_scale"] = o.surface_lr_scale;
   j["intrinsic"] = o.intrinsic;
   j["intrinsic_until"] = o.intrinsic_until;
+  j["spectral_map"] = o.spectral_map;
+  j["spectral_map_until"] = o.spectral_map_until;
   j["parallel_shapes"] = o.parallel_shapes;
   j["pool"] = o.pool;
   j["threads"] = o.threads;
@@ -230,6 +232,14 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (j.contains("intrinsic_until")) field(j, "", "intrinsic_until", o.intrinsic_until);
   if (!(o.intrinsic_until >= 0 && o.intrinsic_until <= 1))
     throw InputError(what + ": intrinsic_until must be in [0, 1]");
+  o.spectral_map = 0;  // later addition: absent = off
+  if (j.contains("spectral_map")) field(j, "", "spectral_map", o.spectral_map);
+  if (!(o.spectral_map >= 0) || !std::isfinite(o.spectral_map))
+    throw InputError(what + ": spectral_map must be >= 0");
+  o.spectral_map_until = 0.5;  // later addition
+  if (j.contains("spectral_map_until")) field(j, "", "spectral_map_until", o.spectral_map_until);
+  if (!(o.spectral_map_until > 0 && o.spectral_map_until <= 1))
+    throw InputError(what + ": spectral_map_until must be in (0, 1]");
   o.parallel_shapes = false;  // later addition: runs before it took one shape at a time
   if (j.contains("parallel_shapes")) field(j, "", "parallel_shapes", o.parallel_shapes);
   o.metric_end = -1;  // later addition: absent = a constant lambda_metric

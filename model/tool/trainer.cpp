@@ -55,6 +55,10 @@ static void validate(const FitOptions& o) {
           "code_lr_scale must be positive and finite");
   require(o.intrinsic >= 0 && std::isfinite(o.intrinsic), "intrinsic must be >= 0 and finite");
   require(o.intrinsic_until >= 0 && o.intrinsic_until <= 1, "intrinsic_until must be in [0, 1]");
+  require(o.spectral_map >= 0 && std::isfinite(o.spectral_map),
+          "spectral_map must be >= 0 and finite");
+  require(o.spectral_map_until > 0 && o.spectral_map_until <= 1,
+          "spectral_map_until must be in (0, 1]");
   require(o.surface_lr_scale >= 0 && std::isfinite(o.surface_lr_scale),
           "surface_lr_scale must be >= 0 and finite");
   const ScheduleOptions& s = o.schedule;
@@ -317,6 +321,22 @@ void Trainer::train_template(int64_t steps, const std::function<bool()>& cancell
   }
 }
 
+void Trainer::set_spectral_map(const Block<double>& template_vertices,
+                               const std::vector<Block<double>>& images) {
+  JSA_CHECK(int(images.size()) == atlas_->shapes(), "one image block per shape");
+  JSA_CHECK(template_vertices.cols() == 3 && template_vertices.rows() > 0,
+            "the template's vertices: V x 3");
+  map_images_.clear();
+  for (int i = 0; i < atlas_->shapes(); ++i) {
+    const Block<double>& image = images[size_t(i)];
+    JSA_CHECK(i == options_.template_shape ||
+                  (image.rows() == template_vertices.rows() && image.cols() == 3),
+              "shape " << i << ": one image per template vertex");
+    map_images_.push_back(image.cast<float>());
+  }
+  map_surface_ = std::make_unique<NearestIndex<float>>(template_vertices.cast<float>());
+}
+
 void Trainer::finish_template() {
   if (template_finished_) return;
   template_finished_ = true;
@@ -387,6 +407,12 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
     objective.components.chart = false;
   if (double(iteration_) < options_.evenness_from * double(options_.iterations))
     objective.weights.evenness = 0;
+  // L_map: from the first joint step, falling linearly to 0 at spectral_map_until.
+  const double map_end = options_.spectral_map_until * double(options_.iterations);
+  const bool map_on =
+      !template_step && map_surface_ && options_.spectral_map > 0 && double(iteration_) < map_end;
+  objective.weights.map = map_on ? options_.spectral_map * (1.0 - double(iteration_) / map_end) : 0;
+  const MapField<float> map_field{options_.template_shape, map_surface_.get(), &map_images_};
 
   // L_full is a sum over shapes (Eq. 12), so its gradient is too: the step's
   // shapes are split into `workers` consecutive groups, each group's share of
@@ -414,6 +440,7 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
     share.code_begin = w == 0 ? first_shape_ : 0;
     share.code_end = w == 0 ? last_shape_ : 0;
     if (intrinsic) share.intrinsic = &field;
+    if (map_on) share.map = &map_field;
     std::vector<Block<float>>& own = worker_targets_[size_t(w)];
     if (workers > 1) own.resize(size_t(end - begin));
     for (int k = begin; k < end; ++k) {
@@ -465,6 +492,7 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
     sums.isometry += p.isometry;
     sums.repulsion += p.repulsion;
     sums.evenness += p.evenness;
+    sums.map += p.map;
   }
   // The test hook counts joint iterations only (the template start has none).
   if (!template_step && counter == fault_at_ && faults_to_inject_ > 0) {
@@ -478,7 +506,7 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
   if (team_ && team_->size() > 1) finite = exchange(sums, finite);
   last_ = sums;
   for (double* v : {&last_.surface, &last_.chart, &last_.cycle_2d, &last_.cycle_6d, &last_.isometry,
-                    &last_.evenness})
+                    &last_.evenness, &last_.map})
     *v /= b;
   report.terms = last_;
   // Template steps and joint iterations in one increasing count: the template

@@ -143,6 +143,12 @@ struct FitOptions {
   // then L_6D: the descriptors place the layouts, the extrinsic terms finish
   // the surfaces. 1: the whole run.
   double intrinsic_until = 1;
+  // Collections: lambda_map of L_map (model/objective.h), the pull of a
+  // spectral map from the template to each shape (set_spectral_map), at the
+  // first joint step; it falls linearly to 0 at spectral_map_until of the
+  // iterations. 0: off.
+  double spectral_map = 0;
+  double spectral_map_until = 0.5;
   // Collections: lambda_metric moves from weights.metric at the first joint
   // step to this value at the first learning-rate decay (geometrically;
   // model/tool/schedule.h, scheduled_weight), then stays. < 0: constant.
@@ -328,6 +334,11 @@ class Trainer {
   // it; `fit` calls it before reading the inputs, so a refused job fails at once.
   static void require_rank_support(const FitOptions& o, int shapes, int ranks);
   void set_template_steps(int64_t n) { options_.template_steps = n; }
+  // L_map's data (FitOptions::spectral_map): the template's vertices in its
+  // unit frame (V_t x 3) and, per shape of the collection, the image of each of
+  // them on that shape, in its unit frame (V_t x 3; the template's own: empty).
+  void set_spectral_map(const Block<double>& template_vertices,
+                        const std::vector<Block<double>>& images);
   double learning_rate() const;  // the schedule at the current iteration, times the fault scale
   // M at the current iteration (the schedule's ramp). The template start runs
   // before iteration 0, so its steps take the ramp's first M.
@@ -386,6 +397,9 @@ class Trainer {
   std::vector<NearestIndex<float>> intrinsic_surfaces_;  // over [x_S, alpha n_S, beta h_S]
   std::unique_ptr<NearestIndex<float>> reference_surface_;
   Block<float> reference_descriptors_;
+  // L_map (FitOptions::spectral_map): the template's vertices, their images.
+  std::unique_ptr<NearestIndex<float>> map_surface_;
+  std::vector<Block<float>> map_images_;
   Team* team_ = nullptr;
   int first_shape_ = 0, last_shape_ = 0;  // this rank's block of shapes
   std::vector<std::pair<size_t, size_t>>

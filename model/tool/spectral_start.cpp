@@ -1,0 +1,41 @@
+#include "model/tool/spectral_start.h"
+
+#include "engine/check.h"
+#include "io/geometry/nearest.h"
+
+namespace jsa {
+
+SpectralStart spectral_start(const std::vector<Mesh>& meshes,
+                             const std::vector<Normalization>& frames, int reference,
+                             const SpectralStartOptions& o) {
+  const size_t n = meshes.size();
+  JSA_CHECK(frames.size() == n && reference >= 0 && size_t(reference) < n,
+            "spectral_start: one frame per mesh, and a reference among them");
+  for (const Mesh& m : meshes)
+    if (m.is_point_cloud())
+      throw InputError("--spectral-map needs triangle meshes (an input is a point cloud)");
+  SpectralStart out;
+  const Mesh& t = meshes[size_t(reference)];
+  out.template_vertices = frames[size_t(reference)].to_unit(t.vertices);
+  const LaplaceBasis on_t = laplace_basis(t, o.functions);
+  ZoomOutOptions zo;
+  zo.k_start = o.k_start;
+  zo.k_end = o.functions;
+  zo.k_step = o.k_step;
+  zo.samples = o.samples;
+  zo.orthogonal = true;
+  out.images.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    if (int(i) == reference) continue;
+    const Block<double> vertices = frames[i].to_unit(meshes[i].vertices);
+    std::vector<int> map;
+    nearest(out.template_vertices, vertices, map);  // the start: nearest in space
+    // ZoomOut's target is the template (the map is defined on its vertices).
+    map = zoomout(laplace_basis(meshes[i], o.functions), on_t, map, zo);
+    out.images[i].resize(Index(map.size()), 3);
+    for (size_t v = 0; v < map.size(); ++v) out.images[i].row(Index(v)) = vertices.row(map[v]);
+  }
+  return out;
+}
+
+}  // namespace jsa

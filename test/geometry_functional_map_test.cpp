@@ -1,0 +1,109 @@
+// io/geometry/functional_map: the cotangent Laplacian's spectrum of a sphere
+// (4 pi l (l + 1) at unit area, multiplicities 1, 3, 5), an M-orthonormal
+// basis, and ZoomOut finding the identity between a strip and the same strip
+// folded, from the nearest-in-space map that the fold gets wrong.
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "engine/check.h"
+#include "io/geometry/builtin_shapes.h"
+#include "io/geometry/functional_map.h"
+#include "io/geometry/nearest.h"
+
+namespace {
+
+using jsa::Block;
+using jsa::Index;
+
+// A strip of (nx x ny) squares of side 1/ny in the plane z = 0; with fold,
+// the part x > crease turned up by 90 degrees about the line x = crease.
+jsa::Mesh strip(int nx, int ny, bool fold, int crease) {
+  jsa::Mesh m;
+  const double side = 1.0 / ny;
+  m.vertices.resize((nx + 1) * (ny + 1), 3);
+  for (int i = 0; i <= nx; ++i)
+    for (int j = 0; j <= ny; ++j) {
+      const double x = i * side, y = j * side, c = crease * side;
+      const Index v = i * (ny + 1) + j;
+      if (fold && i > crease)
+        m.vertices.row(v) << c, y, x - c;
+      else
+        m.vertices.row(v) << x, y, 0;
+    }
+  m.faces.resize(2 * nx * ny, 3);
+  Index f = 0;
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < ny; ++j) {
+      const int a = i * (ny + 1) + j, b = a + ny + 1;
+      m.faces.row(f++) << a, b, b + 1;
+      m.faces.row(f++) << a, b + 1, a + 1;
+    }
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("the Laplace basis of a sphere has its spectrum and is M-orthonormal",
+          "[geometry][functional_map]") {
+  const jsa::Mesh sphere = jsa::builtin_shape("sphere", 48);
+  const jsa::LaplaceBasis b = jsa::laplace_basis(sphere, 16);
+  REQUIRE(b.functions.rows() == sphere.vertices.rows());
+  REQUIRE(b.functions.cols() == 16);
+  CHECK(std::abs(b.mass.sum() - 1.0) < 1e-12);
+  CHECK(std::abs(b.eigenvalues(0)) < 1e-6);
+  // Unit area: radius 1 / sqrt(4 pi), lambda_l = 4 pi l (l + 1). The mesh's
+  // values approach them from its resolution: within 3% at 48 segments.
+  const double pi = 3.14159265358979323846;
+  const int l_of[16] = {0, 1, 1, 1, 2, 2, 2, 2, 2, 3, 3, 3, 3, 3, 3, 3};
+  for (int j = 1; j < 16; ++j) {
+    const double exact = 4 * pi * l_of[j] * (l_of[j] + 1);
+    INFO("eigenvalue " << j << ": " << b.eigenvalues(j) << " against " << exact);
+    CHECK(std::abs(b.eigenvalues(j) - exact) < 0.03 * exact);
+  }
+  Eigen::MatrixXd MF = b.functions;
+  MF.array().colwise() *= b.mass.array();
+  const Eigen::MatrixXd gram = b.functions.transpose() * MF;
+  CHECK((gram - Eigen::MatrixXd::Identity(16, 16)).cwiseAbs().maxCoeff() < 1e-8);
+  // The same start gives the same basis.
+  const jsa::LaplaceBasis again = jsa::laplace_basis(sphere, 16);
+  CHECK((again.functions - b.functions).cwiseAbs().maxCoeff() == 0.0);
+}
+
+TEST_CASE("ZoomOut finds the identity between a strip and the strip folded",
+          "[geometry][functional_map]") {
+  const jsa::Mesh flat = strip(40, 20, false, 0), folded = strip(40, 20, true, 26);
+  const jsa::LaplaceBasis a = jsa::laplace_basis(flat, 60), b = jsa::laplace_basis(folded, 60);
+  // The same connectivity and edge lengths: the same spectrum.
+  CHECK((a.eigenvalues - b.eigenvalues).cwiseAbs().maxCoeff() < 1e-6 * a.eigenvalues.maxCoeff());
+  // Start: every vertex of the folded strip to the nearest vertex of the flat
+  // one, which sends the folded part onto the crease.
+  std::vector<int> start;
+  jsa::nearest(folded.vertices, flat.vertices, start);
+  // How far, along the strip, each vertex is sent from where it belongs.
+  auto mean_error = [&](const std::vector<int>& map) {
+    double sum = 0;
+    for (size_t v = 0; v < map.size(); ++v)
+      sum += (flat.vertices.row(map[v]) - flat.vertices.row(Index(v))).norm();
+    return sum / double(map.size());
+  };
+  const double spacing = 1.0 / 20, before = mean_error(start);
+  REQUIRE(before > 2 * spacing);
+  jsa::ZoomOutOptions o;
+  o.k_start = 4;
+  o.k_end = 60;
+  o.samples = 400;  // of 861 vertices: the sampled sizes and the full last one
+  o.orthogonal = true;
+  const double after = mean_error(jsa::zoomout(a, b, start, o));
+  INFO("mean error " << before << " before, " << after << " after, grid spacing " << spacing);
+  CHECK(after < 0.5 * spacing);
+  // Without the orthogonal C the squashed start stays squashed (the reason
+  // for ZoomOutOptions::orthogonal): it is no better than a few grid spacings.
+  o.orthogonal = false;
+  CHECK(mean_error(jsa::zoomout(a, b, start, o)) > 2 * spacing);
+}
+
+TEST_CASE("a point cloud has no Laplace basis here", "[geometry][functional_map]") {
+  jsa::Mesh cloud;
+  cloud.vertices = Block<double>::Random(20, 3);
+  CHECK_THROWS_AS(jsa::laplace_basis(cloud, 4), jsa::InputError);
+}
