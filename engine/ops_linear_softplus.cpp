@@ -21,8 +21,10 @@
 // so neither z nor z_k is kept: the pull-back of the stacked softplus is
 //   dz   = dy_0 s' + beta (1 - s') sum_k dy_k y_k,
 //   dz_k = dy_k s'.
-// One expm1 per value entry replaces a stored block per layer (measured in
-// docs/performance.md, "A fused linear + softplus").
+// One expm1 per value entry (an exp and a log in Eigen) is what replaces the
+// stored pre-activation block; keeping s' (the value rows' third of it)
+// instead has not been measured (docs/performance.md, "A fused linear +
+// softplus").
 //
 // Threads: tiles are cut from the shapes alone and each tile's Z depends on
 // its rows alone, so Y's bits do not depend on the thread count. dW and db are
