@@ -21,7 +21,9 @@
 # ITERS / WARMUP (5 / 2, torch iterations), CONFIGS ("name:M:K:width:depth ...",
 # for a quick check with small sizes), KERNEL_FLAGS (extra bench_kernels flags,
 # e.g. "--points 2000 --gaussians 2000 --n 300"), BUILD (build directory),
-# NO_BUILD=1 (do not bring the bench targets up to date first), JOBS (build jobs).
+# NO_BUILD=1 (do not bring the bench targets up to date first), JOBS (build jobs),
+# ITER_FLAGS (extra bench_iteration flags, e.g. "--softplus 40" for the default
+# fit's activation; the peers stay ReLU, so the torch ratios are then not like for like).
 set -euo pipefail
 [ $# -eq 1 ] || { echo "usage: $0 OUT_DIR" >&2; exit 2; }
 out="$1"
@@ -55,7 +57,7 @@ for c in $configs; do
   IFS=: read -r name m k w d <<< "$c"
   section "bench_iteration $name: M=$m K=$k ${d}x$w, $threads threads"
   "$b/bench_iteration" --points "$m" --gaussians "$k" --width "$w" --depth "$d" \
-    --threads "$threads" --runs "$runs" --csv "$out/iteration.csv" | tee "$out/iteration_$name.log"
+    --threads "$threads" --runs "$runs" --csv "$out/iteration.csv" ${ITER_FLAGS:-} | tee "$out/iteration_$name.log"
 done
 
 # ---- 1b. the SGEMM choice: Eigen against the BLAS libraries installed

@@ -3,7 +3,11 @@
 // SGEMMs of the same shapes in the same run. Validates before it times: the
 // engine's value rows must equal a plain Eigen forward pass.
 //
-//   bench_mlp_step [--threads N] [--points N] [--runs N]
+//   bench_mlp_step [--threads N] [--points N] [--runs N] [--width W] [--softplus BETA]
+//
+// --softplus BETA: softplus layers instead, each timed two ways in alternation
+// with the SGEMMs, linear then softplus_stacked (two ops) and
+// linear_softplus_stacked (one op, in row tiles); validated against each other.
 //
 // FLOPs counted (R = 3N rows, per layer in -> out):
 //   forward   2 R in out
@@ -34,7 +38,7 @@ using jsa::Block;
 using jsa::Index;
 using jsa::Var;
 
-const std::vector<int> kWidths = {2, 256, 256, 256, 256, 256, 3};
+std::vector<int> kWidths = {2, 256, 256, 256, 256, 256, 3};  // --width sets the hidden ones
 
 using bench::median;
 using bench::seconds_since;
@@ -43,6 +47,8 @@ struct Options {
   int threads = 0;  // 0: OpenMP's default
   Index points = 10000;
   int runs = 7;
+  int width = 256;
+  double softplus = 0;  // 0: ReLU
 };
 
 Options parse(int argc, char** argv) {
@@ -63,8 +69,14 @@ Options parse(int argc, char** argv) {
       o.points = Index(next());
     else if (a == "--runs")
       o.runs = int(next());
+    else if (a == "--width")
+      o.width = int(next());
+    else if (a == "--softplus" && i + 1 < argc)
+      o.softplus = std::atof(argv[++i]);
     else
-      throw std::runtime_error("unknown flag '" + a + "' (flags: --threads N --points N --runs N)");
+      throw std::runtime_error(
+          "unknown flag '" + a +
+          "' (flags: --threads N --points N --runs N --width W --softplus BETA)");
   }
   return o;
 }
@@ -95,10 +107,17 @@ struct Phases {
   double total() const { return forward() + backward; }
 };
 
+// A hidden layer's activation, and how the layer is made.
+struct Activation {
+  float softplus = 0;  // 0: linear then relu_masked
+  bool fused = false;  // softplus: linear_softplus_stacked (else linear then softplus_stacked)
+};
+
 // Forward with stacked Jacobians, a loss on the value and Jacobian rows, backward.
 // Loss: mean |phi(x) - target|^2 + 1e-3 mean((E-1)^2 + (G-1)^2 + 2F^2).
+// A fused layer's time counts as linear.
 float engine_step(jsa::Tape<float>& t, Phi& phi, const Block<float>& x, const Block<float>& target,
-                  Phases* ph) {
+                  Phases* ph, Activation act = {}) {
   const Index n = x.rows();
   auto t0 = Clock::now();
   auto lap = [&t0](double& into) {
@@ -110,9 +129,18 @@ float engine_step(jsa::Tape<float>& t, Phi& phi, const Block<float>& x, const Bl
   t.clear();
   Var h = jsa::stack_tangents(t, t.constant(x));
   for (int l = 0; l < phi.layers(); ++l) {
+    const bool hidden = l + 1 < phi.layers();
+    if (hidden && act.fused) {
+      h = jsa::linear_softplus_stacked(t, h, phi.p.on(t, phi.w[l]), phi.p.on(t, phi.b[l]), n,
+                                       act.softplus);
+      lap(local.linear);
+      continue;
+    }
     h = jsa::linear(t, h, phi.p.on(t, phi.w[l]), phi.p.on(t, phi.b[l]), n);
     lap(local.linear);
-    if (l + 1 < phi.layers()) h = jsa::relu_masked(t, h, n);
+    if (hidden)
+      h = act.softplus > 0 ? jsa::softplus_stacked(t, h, n, act.softplus)
+                           : jsa::relu_masked(t, h, n);
     lap(local.relu);
   }
   const jsa::Stacked s = jsa::unstack(t, h);
@@ -171,8 +199,80 @@ Block<float> plain_forward(const Phi& phi, const Block<float>& x) {
   return h;
 }
 
+// --softplus: the two-op layers and the fused one against the same SGEMMs,
+// the three timed in alternation (a round each, so load falls on all alike).
+int run_softplus(const Options& o) {
+  const Index n = o.points, rows = 3 * n;
+  jsa::Rng rng(1);
+  Block<float> x(n, 2), target(n, 3);
+  for (Index i = 0; i < n; ++i) {
+    const double u = rng.uniform(-1, 1), v = rng.uniform(-1, 1);
+    x.row(i) << float(u), float(v);
+    target.row(i) << float(u), float(v), float(0.5 * std::sin(3 * u) * std::cos(2 * v));
+  }
+  Phi phi(2);
+  double flops = 0;
+  for (size_t l = 0; l + 1 < kWidths.size(); ++l)
+    flops += (l == 0 ? 2.0 : 3.0) * 2.0 * double(rows) * kWidths[l] * kWidths[l + 1];
+  const Activation two{float(o.softplus), false}, one{float(o.softplus), true};
+
+  // Validate: the same loss and parameter gradient both ways (float rounding).
+  jsa::Tape<float> t2, t1;
+  const float l2 = engine_step(t2, phi, x, target, nullptr, two);
+  const std::vector<float> g2 = phi.p.grads();
+  const float l1 = engine_step(t1, phi, x, target, nullptr, one);
+  const std::vector<float> g1 = phi.p.grads();
+  double gerr = 0, gmax = 0;
+  for (size_t k = 0; k < g1.size(); ++k) {
+    gerr = std::max(gerr, double(std::abs(g1[k] - g2[k])));
+    gmax = std::max(gmax, double(std::abs(g2[k])));
+  }
+  std::printf("validate: loss %.7g (two ops) vs %.7g (fused), max |grad diff| %.2e of %.2e\n",
+              double(l2), double(l1), gerr, gmax);
+  if (!(std::abs(l1 - l2) <= 1e-5f * std::abs(l2)) || !(gerr <= 1e-4 * gmax)) {
+    std::fprintf(stderr, "validation failed\n");
+    return 1;
+  }
+
+  Block<float> stacked = Block<float>::Zero(rows, 2);
+  stacked.topRows(n) = x;
+  stacked.middleRows(n, n).col(0).setOnes();
+  stacked.bottomRows(n).col(1).setOnes();
+  GemmOnly gemm(stacked, phi);
+  std::vector<double> t_two, t_one, t_gemm;
+  for (int i = 0; i < o.runs + 2; ++i) {
+    Phases a, b;
+    engine_step(t2, phi, x, target, &a, two);
+    engine_step(t1, phi, x, target, &b, one);
+    const auto g = gemm.step(phi);
+    if (i < 2) continue;
+    t_two.push_back(a.total());
+    t_one.push_back(b.total());
+    t_gemm.push_back(g.first + g.second);
+  }
+  const double m2 = median(t_two), m1 = median(t_one), mg = median(t_gemm);
+  std::printf(
+      "\nphi 2-%dx%d-3 softplus beta %g, N = %ld points (%ld stacked rows), threads = %d, "
+      "median of %d alternated runs\n",
+      o.width, int(kWidths.size()) - 2, o.softplus, long(n), long(rows), jsa::max_threads(),
+      o.runs);
+  std::printf("%-44s %10s %10s %10s\n", "", "median ms", "GFLOP/s", "/ SGEMM");
+  auto line = [&](const char* name, double m) {
+    std::printf("%-44s %10.1f %10.1f %10.3f\n", name, m * 1e3, flops / m * 1e-9, m / mg);
+  };
+  line("engine step, linear + softplus_stacked", m2);
+  line("engine step, linear_softplus_stacked", m1);
+  line("Eigen SGEMM of the same shapes", mg);
+  std::printf("two ops / fused: %.3f\n", m2 / m1);
+  std::printf("tape memory: two ops %.1f MB, fused %.1f MB\n", double(t2.bytes()) / (1 << 20),
+              double(t1.bytes()) / (1 << 20));
+  return 0;
+}
+
 int run(const Options& o) {
   jsa::set_threads(o.threads);
+  for (size_t l = 1; l + 1 < kWidths.size(); ++l) kWidths[l] = o.width;
+  if (o.softplus > 0) return run_softplus(o);
   const Index n = o.points, rows = 3 * n;
   jsa::Rng rng(1);
   Block<float> x(n, 2), target(n, 3);

@@ -183,6 +183,20 @@ void sgemm(Gemm backend, const GemmCall& g, const float* a, const float* b, floa
   eigen_product(A, g.transpose_a, B, g.transpose_b, C, g.accumulate);
 }
 
+template <class T>
+void gemm(const GemmCall& call, const T* a, const T* b, T* c) {
+  if constexpr (std::is_same_v<T, float>) {
+    if (g_recording.load(std::memory_order_relaxed)) record(call);
+    sgemm(gemm_backend(), call, a, b, c);
+  } else {
+    using ConstMap = Eigen::Map<const Block<T>>;
+    const ConstMap A(a, call.transpose_a ? call.k : call.m, call.transpose_a ? call.m : call.k);
+    const ConstMap B(b, call.transpose_b ? call.n : call.k, call.transpose_b ? call.k : call.n);
+    Eigen::Map<Block<T>> C(c, call.m, call.n);
+    eigen_product(A, call.transpose_a, B, call.transpose_b, C, call.accumulate);
+  }
+}
+
 GemmRecorder::GemmRecorder() {
   const std::lock_guard<std::mutex> lock(g_record_mutex);
   JSA_CHECK(!g_recording.load(), "one GemmRecorder at a time");
@@ -201,8 +215,9 @@ std::vector<GemmCall> GemmRecorder::calls() const {
   return g_calls;
 }
 
-#define JSA_INSTANTIATE(T) \
-  template void gemm<T>(const Block<T>&, bool, const Block<T>&, bool, Block<T>&, bool);
+#define JSA_INSTANTIATE(T)                                                              \
+  template void gemm<T>(const Block<T>&, bool, const Block<T>&, bool, Block<T>&, bool); \
+  template void gemm<T>(const GemmCall&, const T*, const T*, T*);
 JSA_INSTANTIATE(float)
 JSA_INSTANTIATE(double)
 

@@ -69,6 +69,14 @@ struct GemmCall {
   int team = 1, thread = 0;
 };
 
+// The same product on raw row-major storage, through gemm_backend() for float
+// (and recorded like the above), Eigen for double: a and b hold op(A) and op(B)
+// before their transposes (k x m when transpose_a, else m x k; likewise b),
+// c is m x n, all contiguous. A run of rows of a block is contiguous, so this is
+// how an op hands over row tiles (engine/ops_linear_softplus.cpp).
+template <class T>
+void gemm(const GemmCall& call, const T* a, const T* b, T* c);
+
 // The same product on raw row-major storage through a given backend (the
 // timing replays recorded calls with it: engine/gemm_timing.h). a holds op(A)
 // before the transpose (k x m when transposed), likewise b; all contiguous.

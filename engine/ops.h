@@ -2,6 +2,9 @@
 // below its forward in the .cpp files, with the local derivative in a comment:
 //   ops_linear.cpp      linear (X W + b), relu, relu_masked, softplus_stacked
 //                       (the last two on stacked tangents)
+//   ops_linear_softplus.cpp  linear_softplus_stacked: linear then
+//                       softplus_stacked as one op, in row tiles (the hidden
+//                       layers of the softplus MLPs)
 //   ops_elementwise.cpp add/sub/mul (row broadcasting), scale, offset, square,
 //                       sqrt, exp, log
 //   ops_rows.cpp        concat/slice of columns and rows, gather rows by index
@@ -34,6 +37,14 @@ Var relu_masked(Tape<T>& t, Var x, Index mask_rows);
 // sigmoid(beta z). A smooth ReLU (beta -> infinity gives ReLU back).
 template <class T>
 Var softplus_stacked(Tape<T>& t, Var x, Index m, T beta);
+
+// ---- one softplus layer (ops_linear_softplus.cpp) ----
+// softplus_stacked(linear(H, W, b, m), m, beta) as one op: H: N x Cin (N a
+// multiple of m), W: Cin x Cout, b: 1 x Cout (on the value rows 0..m) or
+// invalid. The GEMM's output is processed in tiles of `tile` points (rows p..p
+// + tile of every block); 0 sizes them to stay in L2. Keeps Y only, not H W + b.
+template <class T>
+Var linear_softplus_stacked(Tape<T>& t, Var h, Var w, Var b, Index m, T beta, Index tile = 0);
 
 // ---- elementwise (ops_elementwise.cpp) ----
 // b is either the shape of a, or 1 x C and then broadcast over a's rows,

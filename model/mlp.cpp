@@ -65,10 +65,16 @@ Var Mlp<T>::forward(Tape<T>& t, Parameters<T>& params, Var x, Index value_rows, 
     // [h, f] W = h W_h + f W_f: the code enters as part of layer code_layer's bias.
     if (int(k) == shape_.code_layer && code.valid())
       bias = add(t, bias, linear(t, code, params.on(t, code_weight_), Var{}));
-    h = linear(t, h, params.on(t, weight_[k]), bias, value_rows);
-    if (k + 1 < weight_.size())
-      h = shape_.softplus_beta > 0 ? softplus_stacked(t, h, value_rows, T(shape_.softplus_beta))
-                                   : relu_masked(t, h, value_rows);
+    Var w = params.on(t, weight_[k]);
+    const T beta = T(shape_.softplus_beta);
+    if (k + 1 == weight_.size())
+      h = linear(t, h, w, bias, value_rows);
+    else if (beta > 0 && value_rows < rows)  // stacked rows: one op, in row tiles
+      h = linear_softplus_stacked(t, h, w, bias, value_rows, beta);
+    else if (beta > 0)  // plain rows (psi): two ops, faster there (docs/performance.md)
+      h = softplus_stacked(t, linear(t, h, w, bias, value_rows), value_rows, beta);
+    else
+      h = relu_masked(t, linear(t, h, w, bias, value_rows), value_rows);
   }
   return h;
 }

@@ -53,6 +53,24 @@ std::vector<GradCase> op_cases() {
   add_case("softplus_stacked (plain rows)",
            [n](T& t, const Vs& x) { return softplus_stacked(t, x[0], n, 0.5); },
            {signed_block(rng, n, c)});
+  // The fused layer linear_softplus_stacked, checked in H (value and tangent
+  // rows), W and b at once, with the tolerances above. Tiles of 3 and 2 points
+  // over 7 and 5 points: several tiles, and a short last one. Inputs in
+  // +-[0.2, 1) over 3 channels keep z = H W + b within a few units, where
+  // beta = 3 leaves softplus curved (its second derivative, the tangent rows'
+  // pull-back into z, matters) and s' = -expm1(-beta y_0) is far from 0 and 1.
+  const Index p = 7;
+  add_case(
+      "linear_softplus_stacked (3 blocks, tiles of 3)",
+      [p](T& t, const Vs& x) { return linear_softplus_stacked(t, x[0], x[1], x[2], p, 3.0, 3); },
+      {signed_block(rng, 3 * p, 3), signed_block(rng, 3, c), signed_block(rng, 1, c)});
+  add_case(
+      "linear_softplus_stacked (plain rows, tiles of 2)",
+      [n](T& t, const Vs& x) { return linear_softplus_stacked(t, x[0], x[1], x[2], n, 0.5, 2); },
+      {signed_block(rng, n, 3), signed_block(rng, 3, c), signed_block(rng, 1, c)});
+  add_case("linear_softplus_stacked (no bias, automatic tiles)",
+           [p](T& t, const Vs& x) { return linear_softplus_stacked(t, x[0], x[1], Var{}, p, 3.0); },
+           {signed_block(rng, 3 * p, 3), signed_block(rng, 3, c)});
 
   // ---- elementwise, all four broadcast shapes of b ----
   struct Shape {
@@ -404,6 +422,45 @@ TEST_CASE("the same graph twice gives bitwise-identical gradients", "[ops][deter
   CHECK(std::get<0>(first) == std::get<0>(second));
   CHECK(std::get<1>(first) == std::get<1>(second));
   CHECK(std::get<2>(first) == std::get<2>(second));
+}
+
+}  // namespace jsa::test
+
+namespace jsa::test {
+
+// linear_softplus_stacked is linear followed by softplus_stacked, computed in
+// another order: Z in row tiles (each tile's GEMM on its own rows), s' from
+// the output in the pull-back (-expm1(-beta y_0), not from z), dW summed per
+// thread. In float on a block tall enough for several tiles and both threads
+// (1000 points: 4 tiles at width 64; 3 blocks), the value and every gradient
+// must agree with the two ops to 1e-5 of the largest entry (float rounding
+// over sums of 64 and 3000 terms; measured about 1e-7), and twice the same
+// graph must give the same bits.
+TEST_CASE("linear_softplus_stacked equals linear then softplus_stacked", "[ops][float]") {
+  Rng rng(41);
+  const Index m = 1000, cin = 48, c = 64;
+  const float beta = 40.0f;  // the default fit's sharpness: many s' near 0 and 1
+  const Block<float> h0 = signed_block(rng, 3 * m, cin, 0.0, 0.3).cast<float>(),
+                     w0 = signed_block(rng, cin, c, 0.0, 0.3).cast<float>(),
+                     b0 = signed_block(rng, 1, c, 0.0, 0.3).cast<float>(),
+                     r0 = signed_block(rng, 3 * m, c).cast<float>();
+  auto run = [&](bool fused) {
+    Tape<float> t;
+    Var h = t.variable(h0), w = t.variable(w0), b = t.variable(b0);
+    Var y = fused ? linear_softplus_stacked(t, h, w, b, m, beta)
+                  : softplus_stacked(t, linear(t, h, w, b, m), m, beta);
+    t.backward(sum(t, mul(t, y, t.constant(r0))));
+    return std::vector<Block<float>>{t.value(y), t.grad(h), t.grad(w), t.grad(b)};
+  };
+  const auto fused = run(true), twice = run(true), separate = run(false);
+  const char* names[] = {"Y", "dH", "dW", "db"};
+  for (size_t k = 0; k < fused.size(); ++k) {
+    INFO(names[k]);
+    const float scale = separate[k].cwiseAbs().maxCoeff();
+    CHECK(scale > 0);
+    CHECK((fused[k] - separate[k]).cwiseAbs().maxCoeff() <= 1e-5f * scale);
+    CHECK(fused[k] == twice[k]);
+  }
 }
 
 }  // namespace jsa::test

@@ -106,6 +106,30 @@ TEST_CASE("a step's recorded products are those of the run's networks", "[gemm_c
   CHECK(team == (max_threads() >= 2));
 }
 
+// The fused softplus layer's tile products run in a team when there are two
+// threads, recorded in whatever order the threads reach them: the key must
+// not depend on it, or every run would measure afresh and could choose the
+// other backend (a fit on two threads gave different losses twice that way).
+TEST_CASE("the key repeats when the step's products run in a team", "[gemm_choice]") {
+  if (!blas_built_in()) return;
+  FitOptions o = small_run();
+  o.points = 3000;  // phi's 6000 stacked points: several row tiles of the fused layers
+  const std::vector<GemmCall> calls = step_gemm_calls(o, 1);
+  bool team = false;
+  for (const GemmCall& g : calls) team = team || g.team >= 2;
+  CHECK(team == (max_threads() >= 2));
+  const fs::path dir = scratch("team_key");
+  const std::string path = (dir / "gemm.json").string();
+  const GemmChoice first = choose_gemm(o, 1, path);
+  CHECK(first.source == "measured");
+  for (int k = 0; k < 3; ++k) {
+    const GemmChoice again = choose_gemm(o, 1, path);
+    CHECK(again.key == first.key);
+    CHECK(again.source == "cache");
+  }
+  fs::remove_all(dir);
+}
+
 TEST_CASE("auto measures only where the choice is kept, then reads it back", "[gemm_choice]") {
   const FitOptions o = small_run();
   const GemmChoice none = choose_gemm(o, 1, "");

@@ -4,6 +4,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -36,8 +37,16 @@ std::string cpu_model() {
 }
 
 // The step's products as one number (FNV-1a over every field of every call):
-// another network, M, shape count or thread split is another key.
-std::string signature(const std::vector<GemmCall>& calls) {
+// another network, M, shape count or thread split is another key. A team's
+// threads record their calls in the order they start, which the threads'
+// interleaving decides (the fused softplus layer's row tiles, a collection's
+// per-shape workers): the calls are hashed grouped by (team, thread), each
+// thread's in its own order, so the same run gives the same key every time.
+// Without team calls the order, and so the key, is the recorded one.
+std::string signature(std::vector<GemmCall> calls) {
+  std::stable_sort(calls.begin(), calls.end(), [](const GemmCall& a, const GemmCall& b) {
+    return a.team != b.team ? a.team < b.team : a.thread < b.thread;
+  });
   uint64_t h = 14695981039346656037ull;
   auto mix = [&](int64_t v) {
     for (int byte = 0; byte < 8; ++byte) {
