@@ -199,17 +199,24 @@ Block<float> plain_forward(const Phi& phi, const Block<float>& x) {
   return h;
 }
 
-// --softplus: the two-op layers and the fused one against the same SGEMMs,
-// the three timed in alternation (a round each, so load falls on all alike).
-int run_softplus(const Options& o) {
-  const Index n = o.points, rows = 3 * n;
+// n domain points x in [-1, 1]^2 and a smooth surface's points over them.
+void draw_inputs(Index n, Block<float>& x, Block<float>& target) {
   jsa::Rng rng(1);
-  Block<float> x(n, 2), target(n, 3);
+  x.resize(n, 2);
+  target.resize(n, 3);
   for (Index i = 0; i < n; ++i) {
     const double u = rng.uniform(-1, 1), v = rng.uniform(-1, 1);
     x.row(i) << float(u), float(v);
     target.row(i) << float(u), float(v), float(0.5 * std::sin(3 * u) * std::cos(2 * v));
   }
+}
+
+// --softplus: the two-op layers and the fused one against the same SGEMMs,
+// the three timed in alternation (a round each, so load falls on all alike).
+int run_softplus(const Options& o) {
+  const Index n = o.points, rows = 3 * n;
+  Block<float> x, target;
+  draw_inputs(n, x, target);
   Phi phi(2);
   double flops = 0;
   for (size_t l = 0; l + 1 < kWidths.size(); ++l)
@@ -274,13 +281,8 @@ int run(const Options& o) {
   for (size_t l = 1; l + 1 < kWidths.size(); ++l) kWidths[l] = o.width;
   if (o.softplus > 0) return run_softplus(o);
   const Index n = o.points, rows = 3 * n;
-  jsa::Rng rng(1);
-  Block<float> x(n, 2), target(n, 3);
-  for (Index i = 0; i < n; ++i) {
-    const double u = rng.uniform(-1, 1), v = rng.uniform(-1, 1);
-    x.row(i) << float(u), float(v);
-    target.row(i) << float(u), float(v), float(0.5 * std::sin(3 * u) * std::cos(2 * v));
-  }
+  Block<float> x, target;
+  draw_inputs(n, x, target);
   Phi phi(2);
 
   // FLOPs of one step.

@@ -23,6 +23,21 @@ Components Components::table_row(int row) {
   return c;
 }
 
+namespace {
+
+// phi_t(x_P) of the reference shape t, on the values alone (x_P and t's code
+// held constant): the key of a look-up (L_6D^h's h_t, L_map's T_i) that is a
+// constant of the step, so backward never reaches this pass.
+template <class T>
+Block<T> reference_points(Tape<T>& t, Atlas<T>& atlas, Var x_p, int reference) {
+  const Var x_fixed = t.constant(Block<T>(t.value(x_p)));
+  const Var code_t =
+      atlas.has_codes() ? t.constant(Block<T>(t.value(atlas.phi_code(t, reference)))) : Var{};
+  return t.value(atlas.phi.evaluate(t, atlas.params, x_fixed, false, code_t).points);
+}
+
+}  // namespace
+
 template <class T>
 Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T>& targets, Index m,
                            Rng& rng, const ObjectiveOptions& o, LossTerms* terms,
@@ -69,13 +84,8 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
     // L_6D^h (objective.h): beta h_t(phi_t(x_P)), the reference's descriptor
     // where its surface puts x_P, a constant of the step. phi_t runs on the
     // values alone: nothing downstream reaches the loss, so backward skips it.
-    const Var x_fixed = t.constant(Block<T>(t.value(x_p)));
-    const Var code_t = atlas.has_codes()
-                           ? t.constant(Block<T>(t.value(atlas.phi_code(t, intrinsic->reference))))
-                           : Var{};
-    const SurfacePoints on_t = atlas.phi.evaluate(t, p, x_fixed, false, code_t);
     std::vector<int> near;
-    intrinsic->surface->query(t.value(on_t.points), near);
+    intrinsic->surface->query(reference_points(t, atlas, x_p, intrinsic->reference), near);
     Block<T> h(m, intrinsic->descriptors->cols());
     for (Index i = 0; i < m; ++i) h.row(i) = intrinsic->descriptors->row(near[size_t(i)]);
     generated = concat_cols(t, {generated, t.constant(h)});
@@ -132,13 +142,8 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
   if (w.map > 0 && map && shape != map->reference) {
     // L_map (objective.h): T_i(phi_t(x_P)) a constant of the step, phi_t on
     // the values alone (as L_6D^h's h_t above).
-    const Var x_fixed = t.constant(Block<T>(t.value(x_p)));
-    const Var code_t = atlas.has_codes()
-                           ? t.constant(Block<T>(t.value(atlas.phi_code(t, map->reference))))
-                           : Var{};
-    const SurfacePoints on_t = atlas.phi.evaluate(t, p, x_fixed, false, code_t);
     std::vector<int> near;
-    map->surface->query(t.value(on_t.points), near);
+    map->surface->query(reference_points(t, atlas, x_p, map->reference), near);
     const Block<T>& image = (*map->images)[size_t(shape)];
     Block<T> y(m, 3);
     for (Index i = 0; i < m; ++i) y.row(i) = image.row(near[size_t(i)]);

@@ -469,19 +469,40 @@ TEST_CASE("objective: phi as a deformation per shape (deform_layers): gradients 
 
 namespace {
 
-// One share of all shapes, with or without L_6D^h (model/objective.h).
-double intrinsic_share_value(Atlas<double>& atlas, const std::vector<Block<double>>& targets,
-                             const IntrinsicField<double>* field, Tape<double>& tape,
-                             bool backward) {
+// Two shapes, phi a deformation (deform_layers) with D's output layer at its
+// full size, so that the shapes differ from the start.
+AtlasOptions deformed_pair_options() {
+  AtlasOptions ao = small_atlas_options();
+  ao.shapes = 2;
+  ao.code_size = 4;
+  ao.deform_layers = 2;
+  ao.softplus_beta = 10;
+  return ao;
+}
+
+void initialize_deformed(Atlas<double>& atlas) {
+  Rng init(6);
+  atlas.initialize(init);
+  for (const char* name : {"phi.deform.w2", "phi.deform.b2"})
+    atlas.params.value(atlas.params.find(name)) *= 100.0;
+}
+
+// One share of both shapes, with or without L_6D^h and L_map (model/objective.h).
+double share_value(Atlas<double>& atlas, const std::vector<Block<double>>& targets,
+                   const IntrinsicField<double>* intrinsic, const MapField<double>* map,
+                   double w_map, Tape<double>& tape, bool backward, LossTerms* terms = nullptr) {
   std::vector<Rng> rngs{Rng(99, 0), Rng(99, 1)};
   ObjectiveShare<double> share;
   share.shapes = {0, 1};
   share.rngs = {&rngs[0], &rngs[1]};
   share.batch = 2;
   share.code_end = 2;
-  share.intrinsic = field;
+  share.intrinsic = intrinsic;
+  share.map = map;
+  ObjectiveOptions o;
+  o.weights.map = w_map;
   tape.clear();
-  Var loss = objective_share(tape, atlas, targets, 24, ObjectiveOptions{}, share, nullptr);
+  Var loss = objective_share(tape, atlas, targets, 24, o, share, terms);
   if (backward) {
     atlas.params.zero_grad();
     tape.backward(loss);
@@ -489,19 +510,18 @@ double intrinsic_share_value(Atlas<double>& atlas, const std::vector<Block<doubl
   return tape.scalar(loss);
 }
 
+double intrinsic_share_value(Atlas<double>& atlas, const std::vector<Block<double>>& targets,
+                             const IntrinsicField<double>* field, Tape<double>& tape,
+                             bool backward) {
+  return share_value(atlas, targets, field, nullptr, 0, tape, backward);
+}
+
 }  // namespace
 
 TEST_CASE("objective: L_6D^h, descriptors appended to L_6D (intrinsic)", "[objective]") {
-  AtlasOptions ao = small_atlas_options();
-  ao.shapes = 2;
-  ao.code_size = 4;
-  ao.deform_layers = 2;
-  ao.softplus_beta = 10;
+  const AtlasOptions ao = deformed_pair_options();
   Atlas<double> atlas(ao);
-  Rng init(6);
-  atlas.initialize(init);
-  for (const char* name : {"phi.deform.w2", "phi.deform.b2"})
-    atlas.params.value(atlas.params.find(name)) *= 100.0;
+  initialize_deformed(atlas);
   const std::vector<Block<double>> six{random_targets(32, ao.alpha, 3),
                                        random_targets(32, ao.alpha, 4)};
   // The reference (shape 1) carries h = beta (x, y^2, z) at its samples; each
@@ -562,41 +582,18 @@ TEST_CASE("objective: L_6D^h, descriptors appended to L_6D (intrinsic)", "[objec
 
 namespace {
 
-// One share of both shapes with L_map (model/objective.h) at weight w.
 double map_share_value(Atlas<double>& atlas, const std::vector<Block<double>>& targets,
                        const MapField<double>* field, double w, Tape<double>& tape, bool backward,
                        LossTerms* terms = nullptr) {
-  std::vector<Rng> rngs{Rng(99, 0), Rng(99, 1)};
-  ObjectiveShare<double> share;
-  share.shapes = {0, 1};
-  share.rngs = {&rngs[0], &rngs[1]};
-  share.batch = 2;
-  share.code_end = 2;
-  share.map = field;
-  ObjectiveOptions o;
-  o.weights.map = w;
-  tape.clear();
-  Var loss = objective_share(tape, atlas, targets, 24, o, share, terms);
-  if (backward) {
-    atlas.params.zero_grad();
-    tape.backward(loss);
-  }
-  return tape.scalar(loss);
+  return share_value(atlas, targets, nullptr, field, w, tape, backward, terms);
 }
 
 }  // namespace
 
 TEST_CASE("objective: L_map, the pull towards a spectral map's image", "[objective]") {
-  AtlasOptions ao = small_atlas_options();
-  ao.shapes = 2;
-  ao.code_size = 4;
-  ao.deform_layers = 2;
-  ao.softplus_beta = 10;
+  const AtlasOptions ao = deformed_pair_options();
   Atlas<double> atlas(ao);
-  Rng init(6);
-  atlas.initialize(init);
-  for (const char* name : {"phi.deform.w2", "phi.deform.b2"})
-    atlas.params.value(atlas.params.find(name)) *= 100.0;
+  initialize_deformed(atlas);
   const std::vector<Block<double>> targets{random_targets(32, ao.alpha, 3),
                                            random_targets(32, ao.alpha, 4)};
   // The template is shape 1; its "vertices" and, for shape 0, their images:
