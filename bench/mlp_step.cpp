@@ -211,6 +211,16 @@ void draw_inputs(Index n, Block<float>& x, Block<float>& target) {
   }
 }
 
+// The stacked rows [x; e_u; e_v] (3n x 2) phi's first layer reads.
+Block<float> stacked_input(const Block<float>& x) {
+  const Index n = x.rows();
+  Block<float> stacked = Block<float>::Zero(3 * n, 2);
+  stacked.topRows(n) = x;
+  stacked.middleRows(n, n).col(0).setOnes();
+  stacked.bottomRows(n).col(1).setOnes();
+  return stacked;
+}
+
 // --softplus: the two-op layers and the fused one against the same SGEMMs,
 // the three timed in alternation (a round each, so load falls on all alike).
 int run_softplus(const Options& o) {
@@ -241,10 +251,7 @@ int run_softplus(const Options& o) {
     return 1;
   }
 
-  Block<float> stacked = Block<float>::Zero(rows, 2);
-  stacked.topRows(n) = x;
-  stacked.middleRows(n, n).col(0).setOnes();
-  stacked.bottomRows(n).col(1).setOnes();
+  const Block<float> stacked = stacked_input(x);
   GemmOnly gemm(stacked, phi);
   std::vector<double> t_two, t_one, t_gemm;
   for (int i = 0; i < o.runs + 2; ++i) {
@@ -321,10 +328,7 @@ int run(const Options& o) {
 
   // Time the engine step and the GEMMs alone in alternation, so that load from
   // other processes on the machine falls on both alike. Two warm-up rounds.
-  Block<float> stacked = Block<float>::Zero(rows, 2);
-  stacked.topRows(n) = x;
-  stacked.middleRows(n, n).col(0).setOnes();
-  stacked.bottomRows(n).col(1).setOnes();
+  const Block<float> stacked = stacked_input(x);
   GemmOnly gemm(stacked, phi);
   std::vector<Phases> eng;
   std::vector<std::pair<double, double>> gem;
