@@ -17,6 +17,7 @@
 #include "model/tool/correspondence.h"
 #include "model/tool/fit_config.h"
 #include "model/tool/shape_input.h"
+#include "model/tool/spectral_refinement.h"
 
 namespace jsa::cli {
 namespace {
@@ -72,8 +73,35 @@ struct CorrespondArgs {
   std::string run, points_file, out;
   std::vector<long> vertices;
   int from = 0, to = 1, threads = 0;
-  bool snap = false, nearest_rule = false;
+  bool snap = false, nearest_rule = false, spectral = false;
+  SpectralRefinementOptions spectral_options;
 };
+
+// Flags of the spectral refinement, shared by correspond and eval-corr.
+void add_spectral_flags(CLI::App* c, bool& on, SpectralRefinementOptions& o) {
+  c->add_flag("--spectral", on,
+              "Refine the atlas's map by ZoomOut on the shapes' Laplace-Beltrami "
+              "eigenfunctions (meshes only; docs/collections.md)");
+  c->add_option("--spectral-functions", o.functions,
+                "--spectral: eigenfunctions per shape, ZoomOut's last size")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 500));
+  c->add_option("--spectral-k-start", o.k_start,
+                "--spectral: ZoomOut's first size (how much of the atlas's map is kept)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 500));
+  c->add_option("--spectral-prior", o.prior_weight,
+                "--spectral: weight of the atlas's map as a spatial prior in ZoomOut (0: none)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e6));
+  c->add_option("--spectral-prior-until", o.prior_until,
+                "--spectral: the prior acts on ZoomOut's sizes below this")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1 << 30));
+  c->add_flag("!--spectral-one-way", o.both_directions,
+              "--spectral: refine the direction I -> J only (by default both directions are "
+              "refined and, per point, the image nearer the atlas's own is taken)");
+}
 
 void run_correspond(const CorrespondArgs& a) {
   set_threads(a.threads);
@@ -108,8 +136,16 @@ void run_correspond(const CorrespondArgs& a) {
   }
   CorrespondenceOptions co;
   co.use_chart = r.options.components.chart && !a.nearest_rule;
-  const Block<double> q =
-      fj.from_unit(correspond(*r.atlas, a.from, a.to, fi.to_unit(p), fi.normals_to_unit(pn), co));
+  CorrespondenceMap map = [&](int from, int to, const Block<double>& pu,
+                              const Block<double>& normals) {
+    return correspond(*r.atlas, from, to, pu, normals, co);
+  };
+  if (a.spectral) {
+    std::vector<Mesh> meshes;
+    for (const std::string& input : r.contents.inputs) meshes.push_back(load_shape(input));
+    map = spectral_refinement(map, meshes, r.contents.normalizations, a.spectral_options);
+  }
+  const Block<double> q = fj.from_unit(map(a.from, a.to, fi.to_unit(p), fi.normals_to_unit(pn)));
   std::vector<int> snapped;
   if (a.snap) {
     const Mesh target = load_shape(r.contents.inputs[size_t(a.to)]);
@@ -133,8 +169,9 @@ void run_correspond(const CorrespondArgs& a) {
 struct EvalCorrArgs {
   std::string run;
   std::vector<std::string> keypoints;
-  bool nearest_rule = false;
+  bool nearest_rule = false, spectral = false;
   int threads = 0, refine = 0;
+  SpectralRefinementOptions spectral_options;
 };
 
 void run_eval_corr(const EvalCorrArgs& a) {
@@ -167,12 +204,20 @@ void run_eval_corr(const EvalCorrArgs& a) {
   CorrespondenceOptions co;
   co.use_chart = r.options.components.chart && !a.nearest_rule;
   co.refine_steps = a.refine;
-  const KeypointError e =
-      keypoint_error(*r.atlas, meshes, r.contents.normalizations, keypoints, co);
-  const std::string rule = !co.use_chart         ? "nearest-sample rule, no chart"
-                           : co.refine_steps > 0 ? "q = phi_J(u), u = psi_I(p) refined by " +
-                                                       std::to_string(co.refine_steps) + " steps"
-                                                 : "q = phi_J(psi_I(p))";
+  CorrespondenceMap map = [&](int from, int to, const Block<double>& p,
+                              const Block<double>& normals) {
+    return correspond(*r.atlas, from, to, p, normals, co);
+  };
+  if (a.spectral)
+    map = spectral_refinement(map, meshes, r.contents.normalizations, a.spectral_options);
+  const KeypointError e = keypoint_error(map, meshes, r.contents.normalizations, keypoints);
+  std::string rule = !co.use_chart         ? "nearest-sample rule, no chart"
+                     : co.refine_steps > 0 ? "q = phi_J(u), u = psi_I(p) refined by " +
+                                                 std::to_string(co.refine_steps) + " steps"
+                                           : "q = phi_J(psi_I(p))";
+  if (a.spectral)
+    rule += std::string(", refined by ZoomOut") +
+            (a.spectral_options.both_directions ? " (both directions)" : "");
   std::printf("correspondence error over %lld ordered pairs x %lld keypoints (%s)\n",
               (long long)e.pairs, (long long)e.keypoints, rule.c_str());
   std::printf("  mean L2 in the target's unit frame: %.3f x 1e-2\n", 100 * e.mean);
@@ -184,6 +229,13 @@ void run_eval_corr(const EvalCorrArgs& a) {
   j["run"] = a.run;
   j["rule"] = co.use_chart ? "chart" : "nearest-sample";
   j["refine_steps"] = co.use_chart ? co.refine_steps : 0;
+  j["spectral_refinement"] = a.spectral;
+  if (a.spectral) {
+    const SpectralRefinementOptions& so = a.spectral_options;
+    j["spectral"] = {{"functions", so.functions},     {"k_start", so.k_start},
+                     {"k_step", so.k_step},           {"prior", so.prior_weight},
+                     {"prior_until", so.prior_until}, {"both_directions", so.both_directions}};
+  }
   j["mean_l2_unit_frame"] = e.mean;
   j["mean_l2_x1e-2"] = 100 * e.mean;
   j["pairs"] = e.pairs;
@@ -217,6 +269,7 @@ void add_correspond(CLI::App& app) {
   c->add_flag("--snap", a->snap, "Also print the nearest vertex of J's input mesh");
   c->add_flag("--nearest-rule", a->nearest_rule,
               "Use the paper's nearest-sample rule instead of the chart psi");
+  add_spectral_flags(c, a->spectral, a->spectral_options);
   c->add_option("-o,--out", a->out, "Write the points to this file instead of standard output");
   c->add_option("--threads", a->threads, "Threads (0: all cores)")
       ->capture_default_str()
@@ -240,6 +293,7 @@ void add_eval_corr(CLI::App& app) {
                 "before phi_J (0: psi alone, the paper)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1000));
+  add_spectral_flags(c, a->spectral, a->spectral_options);
   c->add_option("--threads", a->threads, "Threads (0: all cores)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1024));

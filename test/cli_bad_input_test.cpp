@@ -92,6 +92,10 @@ TEST_CASE("cli: keypoint indices beyond the mesh are rejected with file and line
   write_text(dir + "/b.vts", "0\nseven\n");
   rejects(eval + dir + "/b.vts", 1, "b.vts:2: expected a vertex index, got 'seven'");
   rejects(eval + dir + "/missing.vts", 1, "missing.vts");
+  // The spectral refinement on a tetrahedron: fewer vertices than eigenfunctions.
+  write_text(dir + "/b.vts", "0\n1\n");
+  rejects(eval + dir + "/b.vts --spectral", 1, "more eigenfunctions than vertices");
+  rejects(eval + dir + "/b.vts --spectral-functions 1", 2, "--spectral-functions");
 }
 
 TEST_CASE("cli: flag values out of range are refused before any work", "[cli]") {

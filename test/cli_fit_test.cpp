@@ -207,6 +207,21 @@ TEST_CASE(
   CHECK((chosen >= 0 && chosen < 3));
   CHECK(fs::exists(dir + "/texture_transfer.png"));
   CHECK(fs::exists(dir + "/collection.png"));
+  // The atlas's map refined by ZoomOut: a vertex carried by correspond lands on
+  // a vertex of the target (--snap gives its index), and eval-corr says the rule.
+  r = run("correspond " + dir + " --from 0 --to 2 --vertices 0,7 --snap --spectral " +
+          "--spectral-functions 12");
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  CHECK(r.output.find("nearest vertex index") != std::string::npos);
+  for (int i = 0; i < 3; ++i) write_text(dir + "/k" + std::to_string(i) + ".vts", "0\n3\n9\n");
+  r = run("eval-corr " + dir + " --keypoints " + dir + "/k0.vts " + dir + "/k1.vts " + dir +
+          "/k2.vts --spectral --spectral-functions 12 --spectral-k-start 4 --spectral-one-way");
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  CHECK(r.output.find("refined by ZoomOut") != std::string::npos);
+  CHECK(read_text(dir + "/eval_corr.json").find("\"spectral_refinement\": true") !=
+        std::string::npos);
   const std::string stem = fs::path(texture).stem().string();
   for (int i = 0; i < 3; ++i) {
     const std::string sub = dir + "/shape_" + std::to_string(i);

@@ -181,6 +181,11 @@ std::vector<int> zoomout(const LaplaceBasis& source, const LaplaceBasis& target,
     std::sort(all.begin(), all.end());
     return all;
   };
+  const bool with_prior = o.prior_weight > 0;
+  if (with_prior)
+    JSA_CHECK(o.prior_on_target.rows() == Vt && o.prior_on_target.cols() == 3 &&
+                  o.prior_on_source.rows() == Vs && o.prior_on_source.cols() == 3,
+              "zoomout: the spatial prior needs V_t x 3 and V_s x 3 positions");
   const std::vector<int> at_t = draw(Vt, 1), at_s = draw(Vs, 2);
   const std::vector<int> all_t = every(Vt), all_s = every(Vs);
   for (int k = std::min(o.k_start, k_end); k <= k_end; k += o.k_step) {
@@ -209,12 +214,19 @@ std::vector<int> zoomout(const LaplaceBasis& source, const LaplaceBasis& target,
     }
     // The new map: y -> the source vertex whose spectral coordinates are
     // nearest to Phi_t[y] C.
-    Eigen::MatrixXd queries(Index(rows_t.size()), k);
-    for (Index r = 0; r < queries.rows(); ++r)
-      queries.row(r) = target.functions.row(rows_t[size_t(r)]).head(k) * C;
-    Eigen::MatrixXd database(Index(cols_s.size()), k);
-    for (Index r = 0; r < database.rows(); ++r)
-      database.row(r) = source.functions.row(cols_s[size_t(r)]).head(k);
+    const bool prior = with_prior && k < o.prior_until;
+    const Index extra = prior ? 3 : 0;
+    const double w = prior ? o.prior_weight * std::sqrt(target.eigenvalues.head(k).sum()) : 0;
+    Eigen::MatrixXd queries(Index(rows_t.size()), k + extra);
+    for (Index r = 0; r < queries.rows(); ++r) {
+      queries.row(r).head(k) = target.functions.row(rows_t[size_t(r)]).head(k) * C;
+      if (prior) queries.row(r).tail(3) = w * o.prior_on_target.row(rows_t[size_t(r)]);
+    }
+    Eigen::MatrixXd database(Index(cols_s.size()), k + extra);
+    for (Index r = 0; r < database.rows(); ++r) {
+      database.row(r).head(k) = source.functions.row(cols_s[size_t(r)]).head(k);
+      if (prior) database.row(r).tail(3) = w * o.prior_on_source.row(cols_s[size_t(r)]);
+    }
     const std::vector<int> near = nearest_by_products(queries, database);
     for (size_t r = 0; r < near.size(); ++r) map[size_t(rows_t[r])] = cols_s[size_t(near[r])];
     if (last) break;

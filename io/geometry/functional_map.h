@@ -49,6 +49,19 @@ struct ZoomOutOptions {
   bool orthogonal = false;  // C projected onto the orthogonal matrices at every size
   int samples = 3000;       // vertices per shape at every size but the last (0: all)
   uint64_t seed = 1;        // of their draw
+  // A spatial prior (empty: none). Each size's map step also weighs how far
+  // source vertex x lies from where the start put y: the query row is
+  // [Phi_t[y] C, w a_y], the database row [Phi_s[x], w p_x], with a_y the
+  // start's image of target vertex y and p_x source vertex x, both in the
+  // source's frame (V_t x 3 and V_s x 3). w = prior_weight times
+  // sqrt(lambda_1 + ... + lambda_k) of the target: a displacement d moves the
+  // first k spectral coordinates by about that times d, so prior_weight = 1
+  // counts distance in space about as much as distance along the surface.
+  // Why: an intrinsic symmetry (an ant's left and right legs) leaves the
+  // spectral distances tied; the prior breaks the tie the start's way.
+  Eigen::MatrixXd prior_on_target, prior_on_source;
+  double prior_weight = 0;
+  int prior_until = 1 << 30;  // the prior acts on sizes k < prior_until only
 };
 
 // ZoomOut from `map` (target vertex -> source vertex, one entry per target
