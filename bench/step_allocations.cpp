@@ -17,14 +17,10 @@
 // its count (the binary is linked with -rdynamic for the names; inlined
 // functions show as their caller).
 //
-// How: this program defines malloc, calloc, realloc, free and the aligned
-// allocators itself, so the dynamic linker binds every library's calls to
-// them (ELF symbol interposition); each forwards to glibc's __libc_* entry and
-// adds one to a counter while counting is on. Not under AddressSanitizer,
-// which replaces the same symbols.
+// How: test/allocation_counter.h, which defines malloc and its kin in this
+// program so that every library's calls come to it (not under AddressSanitizer).
 #include <cxxabi.h>
 #include <execinfo.h>
-#include <malloc.h>
 
 #include <algorithm>
 #include <atomic>
@@ -38,38 +34,24 @@
 #include "engine/parallel.h"
 #include "model/tool/shape_input.h"
 #include "model/tool/trainer.h"
-
-extern "C" {
-void* __libc_malloc(size_t);
-void* __libc_calloc(size_t, size_t);
-void* __libc_realloc(void*, size_t);
-void __libc_free(void*);
-void* __libc_memalign(size_t, size_t);
-}
+#include "test/allocation_counter.h"
 
 namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_count{0};
 // --where: up to kTraces call stacks of kDepth frames, recorded in place (no
 // allocation inside the hook; backtrace() is warmed up before counting).
 constexpr int kTraces = 8192, kDepth = 24;
-std::atomic<bool> g_tracing{false};
 std::atomic<int> g_traced{0};
 void* g_frames[kTraces][kDepth];
 int g_depth[kTraces];
 thread_local bool t_in_hook = false;
 
-void count_one() {
-  if (!g_counting.load(std::memory_order_relaxed)) return;
-  g_count.fetch_add(1, std::memory_order_relaxed);
-  if (g_tracing.load(std::memory_order_relaxed) && !t_in_hook) {
-    const int k = g_traced.fetch_add(1);
-    if (k < kTraces) {
-      t_in_hook = true;
-      g_depth[k] = backtrace(g_frames[k], kDepth);
-      t_in_hook = false;
-    }
-  }
+void record_stack() {
+  if (t_in_hook) return;
+  const int k = g_traced.fetch_add(1);
+  if (k >= kTraces) return;
+  t_in_hook = true;
+  g_depth[k] = backtrace(g_frames[k], kDepth);
+  t_in_hook = false;
 }
 
 // One frame as "function" (demangled, without its argument list), or the raw line.
@@ -101,44 +83,14 @@ void print_stacks() {
   }
   std::vector<std::pair<int, const std::vector<std::string>*>> order;
   for (const auto& [names, count] : stacks) order.push_back({count, &names});
-  std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::sort(order.begin(), order.end(),
+            [](const auto& a, const auto& b) { return a.first > b.first; });
   for (const auto& [count, names] : order) {
     std::printf("%d x\n", count);
     for (const std::string& name : *names) std::printf("    %s\n", name.c_str());
   }
 }
 }  // namespace
-
-extern "C" {
-void* malloc(size_t n) {
-  count_one();
-  return __libc_malloc(n);
-}
-void* calloc(size_t n, size_t size) {
-  count_one();
-  return __libc_calloc(n, size);
-}
-void* realloc(void* p, size_t n) {
-  count_one();
-  return __libc_realloc(p, n);
-}
-void free(void* p) { __libc_free(p); }
-void* memalign(size_t alignment, size_t n) {
-  count_one();
-  return __libc_memalign(alignment, n);
-}
-void* aligned_alloc(size_t alignment, size_t n) {
-  count_one();
-  return __libc_memalign(alignment, n);
-}
-int posix_memalign(void** out, size_t alignment, size_t n) {
-  count_one();
-  void* p = __libc_memalign(alignment, n);
-  if (!p) return 12;  // ENOMEM
-  *out = p;
-  return 0;
-}
-}
 
 using namespace jsa;
 
@@ -166,6 +118,10 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   if (inputs.empty()) inputs = {"builtin:torus"};
 
+  if (!allocation_counter::counting_available()) {
+    std::fprintf(stderr, "bench_step_allocations: no counting under a sanitizer\n");
+    return 1;
+  }
   try {
     FitOptions o;
     const bool collection = inputs.size() > 1;
@@ -195,13 +151,11 @@ int main(int argc, char** argv) {
     std::vector<long> counts;
     for (int i = 0; i < steps; ++i) {
       const int64_t at = trainer.iteration();
-      g_count.store(0);
       g_traced.store(0);
-      g_tracing.store(where && i + 1 == steps);
-      g_counting.store(true);
+      allocation_counter::on_allocation = where && i + 1 == steps ? record_stack : nullptr;
+      allocation_counter::start();
       trainer.step();
-      g_counting.store(false);
-      const long n = g_count.load();
+      const long n = allocation_counter::stop();
       counts.push_back(n);
       std::string note;
       if (at % Trainer::kSnapshotEvery == 0) note += " (snapshot)";
