@@ -571,8 +571,8 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
         hold(i, options_.surface_lr_scale);
     }
   adam_.step(atlas_->params, lr);
-  for (size_t k = 0; k < held_count; ++k) {
-    const Held& h = held[k];
+  for (size_t j = 0; j < held_count; ++j) {
+    const Held& h = held[j];
     float* v = atlas_->params.values().data() + h.offset;
     for (size_t k = 0; k < h.old.size(); ++k) v[k] = h.old[k] + h.scale * (v[k] - h.old[k]);
   }
