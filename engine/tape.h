@@ -65,10 +65,14 @@ class VarList {
   VarList() = default;
   // The braced list's array outlives the call that takes the VarList (a full
   // expression), which is all an op needs; a VarList is never stored.
+#if defined(__GNUC__) && !defined(__clang__)  // GCC's warning; clang has no such group
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Winit-list-lifetime"
+#endif
   VarList(std::initializer_list<Var> list) : data_(list.begin()), size_(list.size()) {}
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
   VarList(const std::vector<Var>& list) : data_(list.data()), size_(list.size()) {}
   const Var* begin() const { return data_; }
   const Var* end() const { return data_ + size_; }
