@@ -35,21 +35,14 @@ void record(GemmCall call) {
   g_calls.push_back(call);
 }
 
-// C (+)= op(A) op(B) by Eigen, on blocks or on maps of raw storage: the same
-// products the linear op always wrote (c.noalias() (+)= a * b), so Eigen's
-// results keep their bits, with Eigen's packing buffers kept between
-// products rather than taken from the heap (engine/gemm_kept_buffers.h).
+// C (+)= op(A) op(B) by Eigen, on blocks or on maps of raw storage: the
+// products the linear op always wrote (c.noalias() (+)= a * b), by Eigen's
+// own product routine, with its packing buffers kept between products rather
+// than taken from the heap (engine/gemm_kept_buffers.h).
 template <class A, class B, class C>
 void eigen_product(const A& a, bool transpose_a, const B& b, bool transpose_b, C& c,
                    bool accumulate) {
-  if (transpose_a && transpose_b)
-    kept_gemm::product(c, a.transpose(), b.transpose(), accumulate);
-  else if (transpose_a)
-    kept_gemm::product(c, a.transpose(), b, accumulate);
-  else if (transpose_b)
-    kept_gemm::product(c, a, b.transpose(), accumulate);
-  else
-    kept_gemm::product(c, a, b, accumulate);
+  kept_gemm::product(a, transpose_a, b, transpose_b, c, accumulate);
 }
 
 #ifdef JSATLAS_HAVE_BLAS

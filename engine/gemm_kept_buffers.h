@@ -1,31 +1,26 @@
-// Eigen's GEMM without its heap: the same product, the same blocking and the
-// same bits as `C.noalias() (+)= A * B`, with the packing buffers kept from one
-// product to the next instead of taken from the heap every time.
+// Eigen's GEMM without a heap allocation per product: row-major C (+)= op(A)
+// op(B) through Eigen's own blocked product, with the packing buffers kept by
+// each thread from one product to the next.
 //
 // Why: Eigen packs panels of A and B into scratch buffers for each large
-// product. It takes them from the stack up to EIGEN_STACK_ALLOCATION_LIMIT
-// (128 KiB) and from the heap beyond, and its threaded product always takes A's
-// from the heap: one to three mallocs per product, 80 of a single shape's
-// training step and 2,160 of a two-shape collection's (whose row-tiled layers,
-// engine/ops_linear_softplus.cpp, make many small products). Eigen has no
-// allocator hook; it does let the caller pass the blocking object that owns
-// the buffers (level3_blocking), and the product kernel type.
+// product. `C.noalias() = A * B` takes them from the stack up to
+// EIGEN_STACK_ALLOCATION_LIMIT (128 KiB) and from the heap beyond, and its
+// threaded product always takes A's from the heap: one to three mallocs a
+// product, 80 of a single shape's training step and 2,160 of a two-shape
+// collection's (whose row-tiled layers, engine/ops_linear_softplus.cpp, make
+// many small products). Eigen has no allocator hook, but its product routine
+// (internal::general_matrix_matrix_product<...>::run) packs into the buffers
+// of the blocking object its caller passes when that object has them. So this
+// file only calls Eigen: it hands that routine a blocking object of ours whose
+// buffers are the thread's kept ones, and it splits the threaded case itself.
 //
-// What is here, all of it Eigen 3.4's own code (GeneralMatrixMatrix.h,
-// Mozilla Public License 2.0, Copyright (C) 2008-2009 Gael Guennebaud)
-// except where marked KEPT:
-//   KeptBlocking  gemm_blocking_space<..., Dynamic>, its sizes computed as
-//                 Eigen computes them, its buffers the calling thread's kept
-//                 ones (KEPT);
-//   KeptGemm      general_matrix_matrix_product: the sequential branch as is
-//                 (it takes the blocking's buffers), the threaded branch with
-//                 each thread's packed B in its own kept buffer (KEPT; Eigen's
-//                 takes it from the stack or the heap);
-//   kept_scale_and_add  generic_product_impl<..., GemmProduct>::scaleAndAddTo
-//                 with those two types, and Eigen's own parallelize_gemm.
-// The blocking sizes, the packing, the kernels and the threads' split are
-// Eigen's, so the results are the bits of Eigen's product
-// (test/engine_gemm_test.cpp compares them). Used by engine/gemm.cpp only.
+// Bits: on one thread (and inside an OpenMP team) this is the call that
+// `C.noalias() (+)= A * B` makes, with the same blocking sizes (Eigen's
+// computeProductBlockingSizes), so the same bits. On several threads Eigen
+// shares one packed B^T between the threads; here each thread runs the
+// sequential product on its own rows of C, with the depth blocking Eigen's
+// threaded product would choose. test/engine_gemm_test.cpp compares both with
+// Eigen's own product. Used by engine/gemm.cpp only.
 #pragma once
 #include <omp.h>
 
@@ -37,280 +32,194 @@
 namespace jsa {
 namespace kept_gemm {
 
-// One thread's packing buffers: grown when a product needs more, never
-// shrunk, freed with the thread. A product uses them only while it runs, and a
-// thread runs one product at a time.
-struct PackingBuffers {
-  void* a = nullptr;
-  void* b = nullptr;
-  size_t a_bytes = 0, b_bytes = 0;
-  ~PackingBuffers() {
-    Eigen::internal::aligned_free(a);
-    Eigen::internal::aligned_free(b);
-  }
-  static void* grow(void*& p, size_t& have, size_t want) {
-    if (want > have) {
-      Eigen::internal::aligned_free(p);
-      p = Eigen::internal::aligned_malloc(want);
-      have = want;
-    }
-    return p;
-  }
-};
-inline PackingBuffers& thread_buffers() {
-  thread_local PackingBuffers buffers;
-  return buffers;
-}
+using Index = Eigen::Index;
 
-// gemm_blocking_space<StorageOrder, Lhs, Rhs, Dynamic, Dynamic, Dynamic>.
-template <int StorageOrder, class LhsScalar_, class RhsScalar_, int KcFactor = 1>
-class KeptBlocking
-    : public Eigen::internal::level3_blocking<
-          std::conditional_t<StorageOrder == Eigen::RowMajor, RhsScalar_, LhsScalar_>,
-          std::conditional_t<StorageOrder == Eigen::RowMajor, LhsScalar_, RhsScalar_>> {
-  enum { Transpose = StorageOrder == Eigen::RowMajor };
-  using LhsScalar = std::conditional_t<Transpose, RhsScalar_, LhsScalar_>;
-  using RhsScalar = std::conditional_t<Transpose, LhsScalar_, RhsScalar_>;
-  using Index = Eigen::Index;
-  Index size_a_ = 0, size_b_ = 0;
-
+// One thread's two packing buffers (the left and the right operand's panels):
+// grown when a product needs more, never shrunk, freed with the thread. A
+// thread runs one product at a time, and a product uses them only while it
+// runs, so one pair a thread is enough.
+class ThreadBuffers {
  public:
-  KeptBlocking(Index rows, Index cols, Index depth, Index num_threads, bool l3_blocking) {
-    this->m_mc = Transpose ? cols : rows;
-    this->m_nc = Transpose ? rows : cols;
-    this->m_kc = depth;
-    if (l3_blocking) {
-      Eigen::internal::computeProductBlockingSizes<LhsScalar, RhsScalar, KcFactor>(
-          this->m_kc, this->m_mc, this->m_nc, num_threads);
-    } else {
-      Index n = this->m_nc;
-      Eigen::internal::computeProductBlockingSizes<LhsScalar, RhsScalar, KcFactor>(
-          this->m_kc, this->m_mc, n, num_threads);
-    }
-    size_a_ = this->m_mc * this->m_kc;
-    size_b_ = this->m_kc * this->m_nc;
-    // KEPT: the sequential product packs into the blocking's buffers when it
-    // has them (Eigen's own leaves them null: stack or heap).
-    allocateAll();
+  ThreadBuffers() = default;
+  ThreadBuffers(const ThreadBuffers&) = delete;
+  ThreadBuffers& operator=(const ThreadBuffers&) = delete;
+  ~ThreadBuffers() {
+    Eigen::internal::aligned_free(left_);
+    Eigen::internal::aligned_free(right_);
+  }
+  template <class Scalar>
+  Scalar* left(Index count) {
+    return static_cast<Scalar*>(at_least(left_, left_bytes_, sizeof(Scalar) * size_t(count)));
+  }
+  template <class Scalar>
+  Scalar* right(Index count) {
+    return static_cast<Scalar*>(at_least(right_, right_bytes_, sizeof(Scalar) * size_t(count)));
+  }
+  static ThreadBuffers& mine() {
+    thread_local ThreadBuffers buffers;
+    return buffers;
   }
 
-  void initParallel(Index rows, Index cols, Index depth, Index num_threads) {
-    this->m_mc = Transpose ? cols : rows;
-    this->m_nc = Transpose ? rows : cols;
-    this->m_kc = depth;
-    this->m_blockA = nullptr;  // KEPT: taken again below at the threaded sizes
-    this->m_blockB = nullptr;
-    Index m = this->m_mc;
-    Eigen::internal::computeProductBlockingSizes<LhsScalar, RhsScalar, KcFactor>(
-        this->m_kc, m, this->m_nc, num_threads);
-    size_a_ = this->m_mc * this->m_kc;
-    size_b_ = this->m_kc * this->m_nc;
-  }
-
-  // KEPT: the calling thread's buffers, not aligned_new.
-  void allocateA() {
-    if (!this->m_blockA) {
-      PackingBuffers& own = thread_buffers();
-      this->m_blockA = static_cast<LhsScalar*>(
-          PackingBuffers::grow(own.a, own.a_bytes, sizeof(LhsScalar) * size_t(size_a_)));
+ private:
+  // The old contents need not survive (a product packs before it reads), so
+  // a larger buffer is a fresh one rather than a reallocation.
+  static void* at_least(void*& buffer, size_t& bytes, size_t wanted) {
+    if (wanted > bytes) {
+      Eigen::internal::aligned_free(buffer);
+      buffer = Eigen::internal::aligned_malloc(wanted);
+      bytes = wanted;
     }
+    return buffer;
   }
-  void allocateB() {
-    if (!this->m_blockB) {
-      PackingBuffers& own = thread_buffers();
-      this->m_blockB = static_cast<RhsScalar*>(
-          PackingBuffers::grow(own.b, own.b_bytes, sizeof(RhsScalar) * size_t(size_b_)));
-    }
-  }
-  void allocateAll() {
-    allocateA();
-    allocateB();
-  }
+  void* left_ = nullptr;
+  void* right_ = nullptr;
+  size_t left_bytes_ = 0, right_bytes_ = 0;
 };
 
-// general_matrix_matrix_product: a row-major destination is the transposed
-// column-major product.
-template <class Index, class LhsScalar, int LhsStorageOrder, bool ConjugateLhs, class RhsScalar,
-          int RhsStorageOrder, bool ConjugateRhs, int ResStorageOrder, int ResInnerStride>
-struct KeptGemm;
-
-template <class Index, class LhsScalar, int LhsStorageOrder, bool ConjugateLhs, class RhsScalar,
-          int RhsStorageOrder, bool ConjugateRhs, int ResInnerStride>
-struct KeptGemm<Index, LhsScalar, LhsStorageOrder, ConjugateLhs, RhsScalar, RhsStorageOrder,
-                ConjugateRhs, Eigen::RowMajor, ResInnerStride> {
-  using Traits = Eigen::internal::gebp_traits<RhsScalar, LhsScalar>;
-  using ResScalar = typename Eigen::ScalarBinaryOpTraits<LhsScalar, RhsScalar>::ReturnType;
-  static void run(Index rows, Index cols, Index depth, const LhsScalar* lhs, Index lhsStride,
-                  const RhsScalar* rhs, Index rhsStride, ResScalar* res, Index resIncr,
-                  Index resStride, ResScalar alpha,
-                  Eigen::internal::level3_blocking<RhsScalar, LhsScalar>& blocking,
-                  Eigen::internal::GemmParallelInfo<Index>* info = nullptr) {
-    KeptGemm<Index, RhsScalar,
-             RhsStorageOrder == Eigen::RowMajor ? Eigen::ColMajor : Eigen::RowMajor, ConjugateRhs,
-             LhsScalar, LhsStorageOrder == Eigen::RowMajor ? Eigen::ColMajor : Eigen::RowMajor,
-             ConjugateLhs, Eigen::ColMajor, ResInnerStride>::run(cols, rows, depth, rhs, rhsStride,
-                                                                 lhs, lhsStride, res, resIncr,
-                                                                 resStride, alpha, blocking, info);
-  }
+// Eigen's product loops over kc terms of the sum, mc rows of its left operand
+// and nc columns of its right one at a time. A row-major C is computed by
+// Eigen as the column-major C^T = op(B)^T op(A)^T, so its left operand has C's
+// n columns as rows, and its right one C's m rows as columns.
+struct BlockSizes {
+  Index kc, mc, nc;
 };
 
-template <class Index, class LhsScalar, int LhsStorageOrder, bool ConjugateLhs, class RhsScalar,
-          int RhsStorageOrder, bool ConjugateRhs, int ResInnerStride>
-struct KeptGemm<Index, LhsScalar, LhsStorageOrder, ConjugateLhs, RhsScalar, RhsStorageOrder,
-                ConjugateRhs, Eigen::ColMajor, ResInnerStride> {
-  using Traits = Eigen::internal::gebp_traits<LhsScalar, RhsScalar>;
-  using ResScalar = typename Eigen::ScalarBinaryOpTraits<LhsScalar, RhsScalar>::ReturnType;
-  static void run(Index rows, Index cols, Index depth, const LhsScalar* _lhs, Index lhsStride,
-                  const RhsScalar* _rhs, Index rhsStride, ResScalar* _res, Index resIncr,
-                  Index resStride, ResScalar alpha,
-                  Eigen::internal::level3_blocking<LhsScalar, RhsScalar>& blocking,
-                  Eigen::internal::GemmParallelInfo<Index>* info = nullptr) {
-    using namespace Eigen::internal;
-    typedef const_blas_data_mapper<LhsScalar, Index, LhsStorageOrder> LhsMapper;
-    typedef const_blas_data_mapper<RhsScalar, Index, RhsStorageOrder> RhsMapper;
-    typedef blas_data_mapper<typename Traits::ResScalar, Index, Eigen::ColMajor, Eigen::Unaligned,
-                             ResInnerStride>
-        ResMapper;
-    LhsMapper lhs(_lhs, lhsStride);
-    RhsMapper rhs(_rhs, rhsStride);
-    ResMapper res(_res, resStride, resIncr);
-
-    Index kc = blocking.kc();
-    Index mc = (std::min)(rows, blocking.mc());
-    Index nc = (std::min)(cols, blocking.nc());
-
-    gemm_pack_lhs<LhsScalar, Index, LhsMapper, Traits::mr, Traits::LhsProgress,
-                  typename Traits::LhsPacket4Packing, LhsStorageOrder>
-        pack_lhs;
-    gemm_pack_rhs<RhsScalar, Index, RhsMapper, Traits::nr, RhsStorageOrder> pack_rhs;
-    gebp_kernel<LhsScalar, RhsScalar, Index, ResMapper, Traits::mr, Traits::nr, ConjugateLhs,
-                ConjugateRhs>
-        gebp;
-
-    if (info) {
-      // The threaded product (Eigen's parallel branch).
-      int tid = omp_get_thread_num();
-      int threads = omp_get_num_threads();
-
-      LhsScalar* blockA = blocking.blockA();
-      std::size_t sizeB = kc * nc;
-      // KEPT: this thread's own buffer (Eigen: the stack up to 128 KiB, else the heap).
-      PackingBuffers& own = thread_buffers();
-      RhsScalar* blockB = static_cast<RhsScalar*>(
-          PackingBuffers::grow(own.b, own.b_bytes, sizeof(RhsScalar) * sizeB));
-
-      for (Index k = 0; k < depth; k += kc) {
-        const Index actual_kc = (std::min)(k + kc, depth) - k;
-        pack_rhs(blockB, rhs.getSubMapper(k, 0), actual_kc, nc);
-        while (info[tid].users != 0) {
-        }
-        info[tid].users = threads;
-        pack_lhs(blockA + info[tid].lhs_start * actual_kc, lhs.getSubMapper(info[tid].lhs_start, k),
-                 actual_kc, info[tid].lhs_length);
-        info[tid].sync = k;
-        for (int shift = 0; shift < threads; ++shift) {
-          int i = (tid + shift) % threads;
-          if (shift > 0) {
-            while (info[i].sync != k) {
-            }
-          }
-          gebp(res.getSubMapper(info[i].lhs_start, 0), blockA + info[i].lhs_start * actual_kc,
-               blockB, info[i].lhs_length, actual_kc, nc, alpha);
-        }
-        for (Index j = nc; j < cols; j += nc) {
-          const Index actual_nc = (std::min)(j + nc, cols) - j;
-          pack_rhs(blockB, rhs.getSubMapper(k, j), actual_kc, actual_nc);
-          gebp(res.getSubMapper(0, j), blockA, blockB, rows, actual_kc, actual_nc, alpha);
-        }
-        for (Index i = 0; i < threads; ++i) info[i].users -= 1;
-      }
-    } else {
-      // The sequential product (Eigen's own branch: the blocking's buffers).
-      namespace internal = Eigen::internal;  // Eigen's stack-buffer macro names it unqualified
-      std::size_t sizeA = kc * mc;
-      std::size_t sizeB = kc * nc;
-      ei_declare_aligned_stack_constructed_variable(LhsScalar, blockA, sizeA, blocking.blockA());
-      ei_declare_aligned_stack_constructed_variable(RhsScalar, blockB, sizeB, blocking.blockB());
-      const bool pack_rhs_once = mc != rows && kc == depth && nc == cols;
-      for (Index i2 = 0; i2 < rows; i2 += mc) {
-        const Index actual_mc = (std::min)(i2 + mc, rows) - i2;
-        for (Index k2 = 0; k2 < depth; k2 += kc) {
-          const Index actual_kc = (std::min)(k2 + kc, depth) - k2;
-          pack_lhs(blockA, lhs.getSubMapper(i2, k2), actual_kc, actual_mc);
-          for (Index j2 = 0; j2 < cols; j2 += nc) {
-            const Index actual_nc = (std::min)(j2 + nc, cols) - j2;
-            if ((!pack_rhs_once) || i2 == 0)
-              pack_rhs(blockB, rhs.getSubMapper(k2, j2), actual_kc, actual_nc);
-            gebp(res.getSubMapper(i2, j2), blockA, blockB, actual_mc, actual_kc, actual_nc, alpha);
-          }
-        }
-      }
-    }
+// The sizes Eigen picks for C = op(A) op(B), C m x n, k terms, when `threads`
+// threads share it (1: the sequential product).
+template <class Scalar>
+BlockSizes eigen_block_sizes(Index m, Index n, Index k, Index threads) {
+  BlockSizes s{k, n, m};
+  if (threads == 1) {
+    Eigen::internal::computeProductBlockingSizes<Scalar, Scalar, 1>(s.kc, s.mc, s.nc, Index(1));
+  } else {
+    // Eigen's threaded product keeps mc at the whole of its left operand
+    // (each thread packs a slice of it) and lets kc and nc follow the threads.
+    Index mc = s.mc;
+    Eigen::internal::computeProductBlockingSizes<Scalar, Scalar, 1>(s.kc, mc, s.nc, threads);
   }
-};
-
-// generic_product_impl<Lhs, Rhs, DenseShape, DenseShape, GemmProduct>::scaleAndAddTo
-// for a product Eigen would run as a GEMM (the caller checks: not the small
-// sizes Eigen evaluates coefficient by coefficient, not a matrix-vector one).
-template <class Dest, class Lhs, class Rhs>
-void kept_scale_and_add(Dest& dst, const Lhs& a_lhs, const Rhs& a_rhs,
-                        const typename Dest::Scalar& alpha) {
-  using namespace Eigen::internal;
-  using Scalar = typename Eigen::Product<Lhs, Rhs>::Scalar;
-  using LhsScalar = typename Lhs::Scalar;
-  using RhsScalar = typename Rhs::Scalar;
-  typedef blas_traits<Lhs> LhsBlasTraits;
-  typedef typename LhsBlasTraits::DirectLinearAccessType ActualLhsType;
-  typedef typename remove_all<ActualLhsType>::type ActualLhsTypeCleaned;
-  typedef blas_traits<Rhs> RhsBlasTraits;
-  typedef typename RhsBlasTraits::DirectLinearAccessType ActualRhsType;
-  typedef typename remove_all<ActualRhsType>::type ActualRhsTypeCleaned;
-
-  typename add_const_on_value_type<ActualLhsType>::type lhs = LhsBlasTraits::extract(a_lhs);
-  typename add_const_on_value_type<ActualRhsType>::type rhs = RhsBlasTraits::extract(a_rhs);
-  Scalar actualAlpha = combine_scalar_factors(alpha, a_lhs, a_rhs);
-
-  typedef KeptBlocking<(Dest::Flags & Eigen::RowMajorBit) ? Eigen::RowMajor : Eigen::ColMajor,
-                       LhsScalar, RhsScalar>
-      BlockingType;
-  typedef gemm_functor<
-      Scalar, Eigen::Index,
-      KeptGemm<
-          Eigen::Index, LhsScalar,
-          (ActualLhsTypeCleaned::Flags & Eigen::RowMajorBit) ? Eigen::RowMajor : Eigen::ColMajor,
-          bool(LhsBlasTraits::NeedToConjugate), RhsScalar,
-          (ActualRhsTypeCleaned::Flags & Eigen::RowMajorBit) ? Eigen::RowMajor : Eigen::ColMajor,
-          bool(RhsBlasTraits::NeedToConjugate),
-          (Dest::Flags & Eigen::RowMajorBit) ? Eigen::RowMajor : Eigen::ColMajor,
-          Dest::InnerStrideAtCompileTime>,
-      ActualLhsTypeCleaned, ActualRhsTypeCleaned, Dest, BlockingType>
-      GemmFunctor;
-
-  BlockingType blocking(dst.rows(), dst.cols(), lhs.cols(), 1, true);
-  parallelize_gemm<(Dest::MaxRowsAtCompileTime > 32 ||
-                    Dest::MaxRowsAtCompileTime == Eigen::Dynamic)>(
-      GemmFunctor(lhs, rhs, dst, actualAlpha, blocking), a_lhs.rows(), a_rhs.cols(), a_lhs.cols(),
-      Dest::Flags & Eigen::RowMajorBit);
+  return s;
 }
 
-// C = A B, or C += A B: Eigen's `C.noalias() (+)= A * B` to the bit, through
-// the kept buffers whenever Eigen would pack.
-template <class Dest, class Lhs, class Rhs>
-void product(Dest& dst, const Lhs& lhs, const Rhs& rhs, bool accumulate) {
-  using Scalar = typename Dest::Scalar;
-  const bool coefficient_based =
-      (rhs.rows() + dst.rows() + dst.cols()) < EIGEN_GEMM_TO_COEFFBASED_THRESHOLD && rhs.rows() > 0;
-  const bool vector_shaped = dst.rows() == 1 || dst.cols() == 1;
-  const bool empty = lhs.cols() == 0 || lhs.rows() == 0 || rhs.cols() == 0;
-  if (coefficient_based || vector_shaped || empty) {  // Eigen packs nothing for these
-    if (accumulate)
-      dst.noalias() += lhs * rhs;
-    else
-      dst.noalias() = lhs * rhs;
+// The blocking object Eigen's product reads its sizes and buffers from, the
+// buffers being the calling thread's kept ones. Construct it on the thread
+// that runs the product.
+template <class Scalar>
+class KeptBlocking : public Eigen::internal::level3_blocking<Scalar, Scalar> {
+ public:
+  explicit KeptBlocking(const BlockSizes& s) {
+    this->m_kc = s.kc;
+    this->m_mc = s.mc;
+    this->m_nc = s.nc;
+    ThreadBuffers& buffers = ThreadBuffers::mine();
+    this->m_blockA = buffers.left<Scalar>(s.kc * s.mc);
+    this->m_blockB = buffers.right<Scalar>(s.kc * s.nc);
+  }
+};
+
+// Row-major C (m x n, row length ldc) += op(A) op(B) on this thread. op(A) is
+// row-major with row length lda when A is not transposed; transposed, A's rows
+// are op(A)'s columns, so op(A) is column-major with the same stride (likewise
+// op(B)). The storage orders are template arguments of Eigen's product, hence
+// the four instantiations.
+template <class Scalar>
+void sequential(Index m, Index n, Index k, const Scalar* a, Index lda, bool transpose_a,
+                const Scalar* b, Index ldb, bool transpose_b, Scalar* c, Index ldc,
+                const BlockSizes& sizes) {
+  KeptBlocking<Scalar> blocking(sizes);
+  auto run = [&](auto lhs_order, auto rhs_order) {
+    using Product = Eigen::internal::general_matrix_matrix_product<
+        Index, Scalar, decltype(lhs_order)::value, false, Scalar, decltype(rhs_order)::value, false,
+        Eigen::RowMajor, /*ResInnerStride=*/1>;
+    Product::run(m, n, k, a, lda, b, ldb, c, /*resIncr=*/1, ldc, Scalar(1), blocking,
+                 /*info=*/nullptr);
+  };
+  using Row = std::integral_constant<int, Eigen::RowMajor>;
+  using Col = std::integral_constant<int, Eigen::ColMajor>;
+  if (transpose_a && transpose_b)
+    run(Col{}, Col{});
+  else if (transpose_a)
+    run(Col{}, Row{});
+  else if (transpose_b)
+    run(Row{}, Col{});
+  else
+    run(Row{}, Row{});
+}
+
+// How many threads Eigen's own product would use: one inside a team, else up
+// to Eigen::nbThreads() (engine/parallel.cpp sets it), no more than one per
+// nr-row slice of C (nr: the width of Eigen's register block) nor one per
+// 50,000 multiply-adds (Eigen's threshold for a thread's share).
+template <class Scalar>
+Index eigen_threads(Index m, Index n, Index k) {
+  if (omp_get_num_threads() > 1) return 1;
+  const Index nr = Eigen::internal::gebp_traits<Scalar, Scalar>::nr;
+  const double work = double(m) * double(n) * double(k);
+  const Index by_rows = m / nr, by_work = Index(work / 50000);
+  return std::max<Index>(1, std::min<Index>({Index(Eigen::nbThreads()), by_rows, by_work}));
+}
+
+// Row-major C += op(A) op(B) for a product Eigen runs as a GEMM, on the
+// threads Eigen would use: C's rows in contiguous slices, one a thread, each a
+// multiple of 4 rows but the last (as Eigen splits them), each thread running
+// the sequential product on its slice with its own buffers.
+template <class Scalar>
+void add_product(Index m, Index n, Index k, const Scalar* a, Index lda, bool transpose_a,
+                 const Scalar* b, Index ldb, bool transpose_b, Scalar* c, Index ldc) {
+  const Index threads = eigen_threads<Scalar>(m, n, k);
+  if (threads == 1) {
+    sequential(m, n, k, a, lda, transpose_a, b, ldb, transpose_b, c, ldc,
+               eigen_block_sizes<Scalar>(m, n, k, 1));
     return;
   }
-  if (!accumulate) dst.setZero();  // as Eigen's evalTo
-  kept_scale_and_add(dst, lhs, rhs, Scalar(1));
+  const BlockSizes sizes = eigen_block_sizes<Scalar>(m, n, k, threads);
+#pragma omp parallel num_threads(int(threads))
+  {
+    const Index team = omp_get_num_threads(), i = omp_get_thread_num();
+    const Index slice = (m / team) & ~Index(3);
+    const Index first = i * slice, rows = i + 1 == team ? m - first : slice;
+    // op(A)'s row r: A's row r, or A's column r when transposed.
+    const Scalar* a_rows = transpose_a ? a + first : a + first * lda;
+    if (rows > 0)
+      sequential(rows, n, k, a_rows, lda, transpose_a, b, ldb, transpose_b, c + first * ldc, ldc,
+                 sizes);
+  }
+}
+
+// C = op(A) op(B), or C += op(A) op(B) with `accumulate`: A, B and C row-major
+// Eigen blocks or maps (contiguous rows, any row length). Products Eigen does
+// not pack for (the small ones it evaluates coefficient by coefficient, the
+// matrix-vector ones, the empty ones) go to Eigen's own expression. The others
+// zero C first when assigning, then add with alpha = 1, which is what Eigen's
+// `C.noalias() = A * B` does.
+template <class A, class B, class C>
+void product(const A& a, bool transpose_a, const B& b, bool transpose_b, C& c, bool accumulate) {
+  static_assert(A::IsRowMajor && B::IsRowMajor && C::IsRowMajor, "row-major blocks only");
+  static_assert(A::InnerStrideAtCompileTime == 1 && B::InnerStrideAtCompileTime == 1 &&
+                    C::InnerStrideAtCompileTime == 1,
+                "contiguous rows only");
+  using Scalar = typename C::Scalar;
+  const Index m = c.rows(), n = c.cols(), k = transpose_a ? a.rows() : a.cols();
+  const bool coefficient_based = k > 0 && (k + m + n) < EIGEN_GEMM_TO_COEFFBASED_THRESHOLD;
+  if (coefficient_based || m == 1 || n == 1 || m == 0 || n == 0 || k == 0) {
+    auto eigen = [&](const auto& opa, const auto& opb) {
+      if (accumulate)
+        c.noalias() += opa * opb;
+      else
+        c.noalias() = opa * opb;
+    };
+    if (transpose_a && transpose_b)
+      eigen(a.transpose(), b.transpose());
+    else if (transpose_a)
+      eigen(a.transpose(), b);
+    else if (transpose_b)
+      eigen(a, b.transpose());
+    else
+      eigen(a, b);
+    return;
+  }
+  if (!accumulate) c.setZero();
+  add_product<Scalar>(m, n, k, a.data(), a.outerStride(), transpose_a, b.data(), b.outerStride(),
+                      transpose_b, c.data(), c.outerStride());
 }
 
 }  // namespace kept_gemm
