@@ -9,6 +9,7 @@
 #include <type_traits>
 
 #include "engine/check.h"
+#include "engine/gemm_kept_buffers.h"
 
 #ifdef JSATLAS_HAVE_BLAS
 #include <cblas.h>
@@ -34,25 +35,14 @@ void record(GemmCall call) {
   g_calls.push_back(call);
 }
 
-// C (+)= op(A) op(B) by Eigen, on blocks or on maps of raw storage: the same
-// expressions the linear op always wrote, so Eigen's results keep their bits.
+// C (+)= op(A) op(B) by Eigen, on blocks or on maps of raw storage: the
+// products the linear op always wrote (c.noalias() (+)= a * b), by Eigen's
+// own product routine, with its packing buffers kept between products rather
+// than taken from the heap (engine/gemm_kept_buffers.h).
 template <class A, class B, class C>
 void eigen_product(const A& a, bool transpose_a, const B& b, bool transpose_b, C& c,
                    bool accumulate) {
-  auto put = [&](const auto& product) {
-    if (accumulate)
-      c.noalias() += product;
-    else
-      c.noalias() = product;
-  };
-  if (transpose_a && transpose_b)
-    put(a.transpose() * b.transpose());
-  else if (transpose_a)
-    put(a.transpose() * b);
-  else if (transpose_b)
-    put(a * b.transpose());
-  else
-    put(a * b);
+  kept_gemm::product(a, transpose_a, b, transpose_b, c, accumulate);
 }
 
 #ifdef JSATLAS_HAVE_BLAS

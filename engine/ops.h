@@ -71,12 +71,13 @@ template <class T>
 Var log(Tape<T>& t, Var x);
 
 // ---- rows and columns (ops_rows.cpp) ----
+// xs: a braced list {a, b} or a vector (VarList, engine/tape.h).
 template <class T>
-Var concat_cols(Tape<T>& t, const std::vector<Var>& xs);
+Var concat_cols(Tape<T>& t, VarList xs);
 template <class T>
 Var slice_cols(Tape<T>& t, Var x, Index begin, Index count);
 template <class T>
-Var concat_rows(Tape<T>& t, const std::vector<Var>& xs);
+Var concat_rows(Tape<T>& t, VarList xs);
 template <class T>
 Var slice_rows(Tape<T>& t, Var x, Index begin, Index count);
 // y_i = x_{index_i}; the pull-back scatter-adds, serially, so it is deterministic.

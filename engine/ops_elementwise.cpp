@@ -21,38 +21,56 @@ Shape broadcast_shape(const Tape<T>& t, Var a, Var b, const char* op) {
   return Shape::Same;
 }
 
-// b expanded to a's shape, as an Eigen expression-free copy (small blocks only
-// take this path: 1xC, Nx1, 1x1).
-template <class T>
-Block<T> expand(const Block<T>& b, Index n, Index c, Shape s) {
+// Calls f with b broadcast to n x c as an Eigen array expression (no
+// expanded copy of b: add and sub run in every step and must not allocate).
+template <class T, class F>
+void with_broadcast(const Block<T>& b, Index n, Index c, Shape s, F&& f) {
+  using Array = Eigen::Array<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   switch (s) {
     case Shape::Same:
-      return b;
+      f(b.array());
+      break;
     case Shape::Row:
-      return b.replicate(n, 1);
+      f(b.row(0).array().replicate(n, 1));
+      break;
     case Shape::Col:
-      return b.replicate(1, c);
+      f(b.col(0).array().replicate(1, c));
+      break;
     case Shape::Scalar:
-      return Block<T>::Constant(n, c, b(0, 0));
+      f(Array::Constant(n, c, b(0, 0)));
+      break;
   }
-  return b;
 }
 
-// The adjoint of expand: sum g back down to b's shape.
+// The adjoint of broadcasting: db += (g summed down to b's shape), or -=
+// when `minus`: the same bits as adding the sum of -g (negation is exact),
+// without a block holding -g.
 template <class T>
-void reduce_into(Block<T>& db, const Block<T>& g, Shape s) {
+void reduce_into(Block<T>& db, const Block<T>& g, Shape s, bool minus = false) {
   switch (s) {
     case Shape::Same:
-      db += g;
+      if (minus)
+        db -= g;
+      else
+        db += g;
       break;
     case Shape::Row:
-      db += g.colwise().sum();
+      if (minus)
+        db -= g.colwise().sum();
+      else
+        db += g.colwise().sum();
       break;
     case Shape::Col:
-      db += g.rowwise().sum();
+      if (minus)
+        db -= g.rowwise().sum();
+      else
+        db += g.rowwise().sum();
       break;
     case Shape::Scalar:
-      db(0, 0) += g.sum();
+      if (minus)
+        db(0, 0) -= g.sum();
+      else
+        db(0, 0) += g.sum();
       break;
   }
 }
@@ -64,10 +82,10 @@ template <class T>
 Var add(Tape<T>& t, Var a, Var b) {
   const Shape s = broadcast_shape(t, a, b, "add");
   Var y = t.node(t.rows(a), t.cols(a), {a, b});
-  if (s == Shape::Same)
-    t.value(y) = t.value(a) + t.value(b);
-  else
-    t.value(y) = t.value(a) + expand(t.value(b), t.rows(a), t.cols(a), s);
+  Block<T>& Y = t.value(y);
+  const Block<T>& A = t.value(a);
+  with_broadcast(t.value(b), A.rows(), A.cols(), s,
+                 [&](const auto& bb) { Y = (A.array() + bb).matrix(); });
   t.on_backward(y, [a, b, s](Tape<T>& t, Var y) {
     if (t.needs_grad(a)) t.grad(a) += t.grad(y);
     if (t.needs_grad(b)) reduce_into(t.grad(b), t.grad(y), s);
@@ -80,16 +98,13 @@ template <class T>
 Var sub(Tape<T>& t, Var a, Var b) {
   const Shape s = broadcast_shape(t, a, b, "sub");
   Var y = t.node(t.rows(a), t.cols(a), {a, b});
-  if (s == Shape::Same)
-    t.value(y) = t.value(a) - t.value(b);
-  else
-    t.value(y) = t.value(a) - expand(t.value(b), t.rows(a), t.cols(a), s);
+  Block<T>& Y = t.value(y);
+  const Block<T>& A = t.value(a);
+  with_broadcast(t.value(b), A.rows(), A.cols(), s,
+                 [&](const auto& bb) { Y = (A.array() - bb).matrix(); });
   t.on_backward(y, [a, b, s](Tape<T>& t, Var y) {
     if (t.needs_grad(a)) t.grad(a) += t.grad(y);
-    if (t.needs_grad(b)) {
-      Block<T> neg = -t.grad(y);
-      reduce_into(t.grad(b), neg, s);
-    }
+    if (t.needs_grad(b)) reduce_into(t.grad(b), t.grad(y), s, /*minus=*/true);
   });
   return y;
 }
@@ -99,22 +114,26 @@ template <class T>
 Var mul(Tape<T>& t, Var a, Var b) {
   const Shape s = broadcast_shape(t, a, b, "mul");
   Var y = t.node(t.rows(a), t.cols(a), {a, b});
-  const Index n = t.rows(a), c = t.cols(a);
-  if (s == Shape::Same)
-    t.value(y) = t.value(a).cwiseProduct(t.value(b));
-  else
-    t.value(y) = t.value(a).cwiseProduct(expand(t.value(b), n, c, s));
-  t.on_backward(y, [a, b, s, n, c](Tape<T>& t, Var y) {
+  Block<T>& Y = t.value(y);
+  const Block<T>& A = t.value(a);
+  with_broadcast(t.value(b), A.rows(), A.cols(), s,
+                 [&](const auto& bb) { Y = (A.array() * bb).matrix(); });
+  t.on_backward(y, [a, b, s](Tape<T>& t, Var y) {
     const Block<T>& dY = t.grad(y);
     if (t.needs_grad(a)) {
-      if (s == Shape::Same)
-        t.grad(a) += dY.cwiseProduct(t.value(b));
-      else
-        t.grad(a) += dY.cwiseProduct(expand(t.value(b), n, c, s));
+      Block<T>& dA = t.grad(a);
+      with_broadcast(t.value(b), dY.rows(), dY.cols(), s,
+                     [&](const auto& bb) { dA.array() += dY.array() * bb; });
     }
     if (t.needs_grad(b)) {
-      Block<T> g = dY.cwiseProduct(t.value(a));
-      reduce_into(t.grad(b), g, s);
+      if (s == Shape::Same) {
+        t.grad(b) += dY.cwiseProduct(t.value(a));
+      } else {
+        // Broadcast b (not in a training step): the product is summed down
+        // from a block of its own.
+        Block<T> g = dY.cwiseProduct(t.value(a));
+        reduce_into(t.grad(b), g, s);
+      }
     }
   });
   return y;

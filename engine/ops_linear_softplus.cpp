@@ -62,11 +62,18 @@ Index tile_points(Index m, Index blocks, Index cols, Index bytes_per_entry, Inde
 // Runs f(thread, first, p0, p1) over tiles of `tile` points covering [0, m):
 // thread p of the team takes the contiguous run tiles * p / team .. tiles * (p
 // + 1) / team, in order (first: its first tile). Returns the team size.
+// When the region would have one thread (one tile, one thread, or inside
+// another team: the trainer's shape workers) the tiles run inline as that
+// thread's, with no region (libgomp would allocate one: region_would_be_serial).
 template <class F>
 int for_tiles(Index m, Index tile, int max_team, F&& f) {
   const Index tiles = (m + tile - 1) / tile;
+  if (tiles <= 1 || max_team <= 1 || region_would_be_serial()) {
+    for (Index k = 0; k < tiles; ++k) f(0, k == 0, k * tile, std::min(m, (k + 1) * tile));
+    return 1;
+  }
   int team = 1;
-#pragma omp parallel num_threads(max_team) if (tiles > 1 && max_team > 1)
+#pragma omp parallel num_threads(max_team)
   {
     const int p = omp_get_thread_num(), size = omp_get_num_threads();
     if (p == 0) team = size;

@@ -52,9 +52,14 @@ template <class T>
 Var row_norm(Tape<T>& t, Var x, T eps) {
   Var y = t.node(t.rows(x), 1, {x});
   t.value(y) = (t.value(x).rowwise().squaredNorm().array() + eps).sqrt();
+  // Row by row: Eigen evaluates a broadcast expression column (dy / y) into a
+  // temporary block, a heap allocation in every step.
   t.on_backward(y, [x](Tape<T>& t, Var y) {
-    const auto s = (t.grad(y).array() / t.value(y).array()).col(0);
-    t.grad(x) += (t.value(x).array().colwise() * s).matrix();
+    const Block<T>& X = t.value(x);
+    const Block<T>& Y = t.value(y);
+    const Block<T>& dY = t.grad(y);
+    Block<T>& dX = t.grad(x);
+    for (Index i = 0; i < X.rows(); ++i) dX.row(i) += X.row(i) * (dY(i, 0) / Y(i, 0));
   });
   return y;
 }

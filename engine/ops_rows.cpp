@@ -6,7 +6,7 @@ namespace jsa {
 
 // y = [x_1 | x_2 | ...] ;  dx_k += dy[:, columns of x_k]
 template <class T>
-Var concat_cols(Tape<T>& t, const std::vector<Var>& xs) {
+Var concat_cols(Tape<T>& t, VarList xs) {
   JSA_CHECK(!xs.empty(), "concat_cols of nothing");
   const Index n = t.rows(xs[0]);
   Index c = 0;
@@ -17,9 +17,12 @@ Var concat_cols(Tape<T>& t, const std::vector<Var>& xs) {
   Var y = t.node(n, c, xs);
   for (Index k = 0, at = 0; k < Index(xs.size()); at += t.cols(xs[k]), ++k)
     t.value(y).middleCols(at, t.cols(xs[k])) = t.value(xs[k]);
-  t.on_backward(y, [xs](Tape<T>& t, Var y) {
-    for (Index k = 0, at = 0; k < Index(xs.size()); at += t.cols(xs[k]), ++k)
-      if (t.needs_grad(xs[k])) t.grad(xs[k]) += t.grad(y).middleCols(at, t.cols(xs[k]));
+  // The inputs' ids are kept on the tape (a captured vector would be a heap copy).
+  t.on_backward(y, [inputs = t.keep(xs)](Tape<T>& t, Var y) {
+    const std::vector<int>& xs = t.kept(inputs);
+    for (Index k = 0, at = 0; k < Index(xs.size()); at += t.cols(Var{xs[k]}), ++k)
+      if (t.needs_grad(Var{xs[k]}))
+        t.grad(Var{xs[k]}) += t.grad(y).middleCols(at, t.cols(Var{xs[k]}));
   });
   return y;
 }
@@ -38,7 +41,7 @@ Var slice_cols(Tape<T>& t, Var x, Index begin, Index count) {
 
 // y = [x_1; x_2; ...] (stacked vertically) ;  dx_k += dy[rows of x_k]
 template <class T>
-Var concat_rows(Tape<T>& t, const std::vector<Var>& xs) {
+Var concat_rows(Tape<T>& t, VarList xs) {
   JSA_CHECK(!xs.empty(), "concat_rows of nothing");
   const Index c = t.cols(xs[0]);
   Index n = 0;
@@ -49,9 +52,11 @@ Var concat_rows(Tape<T>& t, const std::vector<Var>& xs) {
   Var y = t.node(n, c, xs);
   for (Index k = 0, at = 0; k < Index(xs.size()); at += t.rows(xs[k]), ++k)
     t.value(y).middleRows(at, t.rows(xs[k])) = t.value(xs[k]);
-  t.on_backward(y, [xs](Tape<T>& t, Var y) {
-    for (Index k = 0, at = 0; k < Index(xs.size()); at += t.rows(xs[k]), ++k)
-      if (t.needs_grad(xs[k])) t.grad(xs[k]) += t.grad(y).middleRows(at, t.rows(xs[k]));
+  t.on_backward(y, [inputs = t.keep(xs)](Tape<T>& t, Var y) {
+    const std::vector<int>& xs = t.kept(inputs);
+    for (Index k = 0, at = 0; k < Index(xs.size()); at += t.rows(Var{xs[k]}), ++k)
+      if (t.needs_grad(Var{xs[k]}))
+        t.grad(Var{xs[k]}) += t.grad(y).middleRows(at, t.rows(Var{xs[k]}));
   });
   return y;
 }
@@ -91,11 +96,11 @@ Var gather_rows(Tape<T>& t, Var x, const std::vector<int>& index) {
   return y;
 }
 
-#define JSA_INSTANTIATE(T)                                        \
-  template Var concat_cols<T>(Tape<T>&, const std::vector<Var>&); \
-  template Var slice_cols<T>(Tape<T>&, Var, Index, Index);        \
-  template Var concat_rows<T>(Tape<T>&, const std::vector<Var>&); \
-  template Var slice_rows<T>(Tape<T>&, Var, Index, Index);        \
+#define JSA_INSTANTIATE(T)                                 \
+  template Var concat_cols<T>(Tape<T>&, VarList);          \
+  template Var slice_cols<T>(Tape<T>&, Var, Index, Index); \
+  template Var concat_rows<T>(Tape<T>&, VarList);          \
+  template Var slice_rows<T>(Tape<T>&, Var, Index, Index); \
   template Var gather_rows<T>(Tape<T>&, Var, const std::vector<int>&);
 JSA_INSTANTIATE(float)
 JSA_INSTANTIATE(double)

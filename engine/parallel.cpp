@@ -14,6 +14,10 @@ namespace jsa {
 
 int max_threads() { return omp_get_max_threads(); }
 
+bool region_would_be_serial() {
+  return omp_get_max_threads() == 1 || omp_get_active_level() >= omp_get_max_active_levels();
+}
+
 namespace {
 // MXCSR bits: FTZ (bit 15) makes results below 2^-126 zero, DAZ (bit 6) reads
 // such inputs as zero.

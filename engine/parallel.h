@@ -18,11 +18,21 @@ namespace jsa {
 // Threads the engine will use (omp_get_max_threads, 1 without OpenMP).
 int max_threads();
 
+// Whether a parallel region opened here would run on one thread: one thread
+// in all (--threads 1), or inside an active region with no nesting level left
+// (OpenMP's default allows one), which is where the trainer's shape workers
+// run the ops. libgomp allocates a team on the heap for every region of one
+// thread (it keeps only an outermost team of several for the next region), so
+// the engine runs that work inline instead: the same single thread, the same
+// results, no allocation in the step. A region whose `if` or thread count
+// would give it one thread is skipped the same way by its caller.
+bool region_would_be_serial();
+
 // Calls f(begin, end) on consecutive row ranges covering [0, n).
 // Small blocks run inline: a parallel region costs a few microseconds.
 template <class F>
 void parallel_rows(Index n, F&& f, Index grain = 2048) {
-  if (n <= grain) {
+  if (n <= grain || region_would_be_serial()) {
     f(Index(0), n);
     return;
   }

@@ -30,7 +30,7 @@ void Parameters<T>::zero_grad() {
 
 template <class T>
 Var Parameters<T>::on(Tape<T>& t, int i) {
-  Var v = t.variable(Block<T>(value(i)));
+  Var v = t.variable(value(i));  // copied straight into the node (no temporary block)
   // dθ_i += d(node): the leaf hands its gradient to the flat buffer, or to the
   // tape's own buffer of the same layout when it has one (Tape::set_parameter_grads).
   t.on_backward(v, [this, i](Tape<T>& t, Var v) {

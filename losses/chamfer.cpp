@@ -12,17 +12,20 @@ namespace {
 
 // Fills m with both associations; returns CD(x, y), summed in double, in order.
 // x's matches are searched in `surface` when it is given (dense variant), else in y.
+// The searches' scratch, when given, is reused (the op's, kept on its tape).
 template <class T>
 double match_both_ways(const Block<T>& x, const Block<T>& y, const NearestIndex<T>* surface,
-                       ChamferMatches<T>& m, double coverage = 1) {
+                       ChamferMatches<T>& m, double coverage = 1,
+                       NearestScratch<T>* x_search = nullptr,
+                       NearestScratch<T>* y_search = nullptr) {
   JSA_CHECK(x.rows() > 0 && y.rows() > 0,
             "chamfer of an empty set: " << x.rows() << " and " << y.rows() << " points");
   JSA_CHECK(x.cols() == y.cols(), "chamfer: " << x.cols() << " vs " << y.cols() << " columns");
   if (surface)
-    surface->query(x, m.x_to_y, &m.x_squared_distance);
+    surface->query(x, m.x_to_y, &m.x_squared_distance, x_search);
   else
-    nearest(x, y, m.x_to_y, &m.x_squared_distance);
-  nearest(y, x, m.y_to_x, &m.y_squared_distance);
+    nearest(x, y, m.x_to_y, &m.x_squared_distance, x_search);
+  nearest(y, x, m.y_to_x, &m.y_squared_distance, y_search);
   double sx = 0, sy = 0;
   for (T d : m.x_squared_distance) sx += double(d);
   for (T d : m.y_squared_distance) sy += double(d);
@@ -40,9 +43,16 @@ template <class T>
 Var chamfer_op(Tape<T>& t, Var x, Var y, const NearestIndex<T>* surface, ChamferMatches<T>* matches,
                double coverage = 1) {
   JSA_CHECK(coverage >= 0 && std::isfinite(coverage), "chamfer: coverage weight " << coverage);
-  ChamferMatches<T> local;
-  ChamferMatches<T>& m = matches ? *matches : local;
-  const double value = match_both_ways(t.value(x), t.value(y), surface, m, coverage);
+  // The matches and the two searches' trees live on the tape until the next
+  // step's same op reuses them (Tape::workspace): no allocation once warm.
+  struct Scratch {
+    ChamferMatches<T> matches;
+    NearestScratch<T> x_search, y_search;
+  };
+  Scratch& scratch = t.template workspace<Scratch>();
+  ChamferMatches<T>& m = matches ? *matches : scratch.matches;
+  const double value = match_both_ways(t.value(x), t.value(y), surface, m, coverage,
+                                       &scratch.x_search, &scratch.y_search);
   Var out = t.node(1, 1, {x, y});
   t.value(out)(0, 0) = T(value);
   if (!t.needs_grad(out)) return out;

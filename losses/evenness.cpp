@@ -31,6 +31,7 @@ struct MeanGrid {
   double x0 = 0, y0 = 0, h = 1;
   Index nx = 1, ny = 1;
   std::vector<Index> start, order;  // order: sorted position -> mean
+  std::vector<Index> cell, fill;    // building scratch: each mean's cell, the cells' fill
   Index cell_x(double x) const {
     return std::clamp(Index(std::floor((x - x0) / h)), Index(0), nx - 1);
   }
@@ -42,8 +43,7 @@ struct MeanGrid {
 // Cells of side r_c, their count capped near 4 K by doubling the side (a
 // larger side is as correct: a point just scans more means).
 template <class T>
-MeanGrid build_grid(const Block<T>& mu, double r_c) {
-  MeanGrid g;
+void build_grid(const Block<T>& mu, double r_c, MeanGrid& g) {
   const Index K = mu.rows();
   g.x0 = double(mu.col(0).minCoeff());
   g.y0 = double(mu.col(1).minCoeff());
@@ -52,7 +52,8 @@ MeanGrid build_grid(const Block<T>& mu, double r_c) {
   while ((wx / g.h + 1) * (wy / g.h + 1) > 4.0 * double(K) + 16) g.h *= 2;
   g.nx = Index(wx / g.h) + 1;
   g.ny = Index(wy / g.h) + 1;
-  std::vector<Index> cell(size_t(K), 0);
+  std::vector<Index>& cell = g.cell;
+  cell.assign(size_t(K), 0);
   g.start.assign(size_t(g.nx * g.ny + 1), 0);
   for (Index k = 0; k < K; ++k) {
     cell[size_t(k)] = g.cell_y(double(mu(k, 1))) * g.nx + g.cell_x(double(mu(k, 0)));
@@ -60,9 +61,9 @@ MeanGrid build_grid(const Block<T>& mu, double r_c) {
   }
   for (Index c = 0; c < g.nx * g.ny; ++c) g.start[size_t(c + 1)] += g.start[size_t(c)];
   g.order.resize(size_t(K));
-  std::vector<Index> fill(g.start.begin(), g.start.end() - 1);
+  std::vector<Index>& fill = g.fill;
+  fill.assign(g.start.begin(), g.start.end() - 1);
   for (Index k = 0; k < K; ++k) g.order[size_t(fill[size_t(cell[size_t(k)])]++)] = k;
-  return g;
 }
 
 // The kept terms of every point: point n's are entries [begin[n], begin[n + 1])
@@ -124,6 +125,17 @@ double gather_shares(const Block<T>& mu, const MeanGrid& g, double inv_2s2, doub
   return log_sum;
 }
 
+// What the op keeps between its forward and its pull-back, on its tape
+// (Tape::workspace): every vector keeps its capacity from one step to the
+// next, so a step of the same sizes allocates nothing.
+template <class T>
+struct MixtureScratch {
+  MeanGrid grid;
+  std::vector<Shares> parts;  // per thread of the forward
+  Shares shares;              // the parts joined in order
+  Block<double> dmu;          // the pull-back's sums for the means
+};
+
 }  // namespace
 
 template <class T>
@@ -171,12 +183,18 @@ Var mixture_log_density(Tape<T>& t, Var x, Var mu, T sigma, const MixtureDensity
   const double s = double(sigma), inv_2s2 = 1.0 / (2 * s * s);
   const double r2 = 2 * s * s * std::log(1 / o.tolerance);  // r_c^2: w = tolerance there
   const double min_sum = 1000.0 * double(mv.rows()) * o.tolerance;
-  const MeanGrid grid = build_grid(mv, std::sqrt(r2) * (1 + 1e-9));
+  MixtureScratch<T>& scratch = t.template workspace<MixtureScratch<T>>();
+  MeanGrid& grid = scratch.grid;
+  build_grid(mv, std::sqrt(r2) * (1 + 1e-9), grid);
   Block<T>& l = t.value(out);
-  std::vector<Shares> parts(size_t(N > 512 ? max_threads() : 1));
-#pragma omp parallel num_threads(int(parts.size()))
-  {
-    const int teams = omp_get_num_threads(), id = omp_get_thread_num();
+  std::vector<Shares>& parts = scratch.parts;
+  parts.resize(size_t(N > 512 ? max_threads() : 1));
+  for (Shares& part : parts) {
+    part.mean.clear();
+    part.r.clear();
+    part.begin.clear();
+  }
+  auto gather = [&](int id, int teams) {
     const Index begin = N * id / teams, end = N * (id + 1) / teams;
     Shares& part = parts[size_t(id)];
     for (Index n = begin; n < end; ++n) {
@@ -184,8 +202,19 @@ Var mixture_log_density(Tape<T>& t, Var x, Var mu, T sigma, const MixtureDensity
       l(n, 0) = T(gather_shares(mv, grid, inv_2s2, r2, min_sum, double(xv(n, 0)), double(xv(n, 1)),
                                 part.mean, part.r));
     }
+  };
+  // (inside another team a region would have one thread: inline, no region;
+  // engine/parallel.h, region_would_be_serial)
+  if (parts.size() == 1 || region_would_be_serial()) {
+    gather(0, 1);
+  } else {
+#pragma omp parallel num_threads(int(parts.size()))
+    gather(omp_get_thread_num(), omp_get_num_threads());
   }
-  auto shares = std::make_shared<Shares>();
+  Shares* shares = &scratch.shares;  // lives on the tape until its next clear()
+  shares->mean.clear();
+  shares->r.clear();
+  shares->begin.clear();
   for (const Shares& part : parts) {
     const Index offset = Index(shares->mean.size());
     for (Index b : part.begin) shares->begin.push_back(offset + b);
@@ -193,7 +222,8 @@ Var mixture_log_density(Tape<T>& t, Var x, Var mu, T sigma, const MixtureDensity
     shares->r.insert(shares->r.end(), part.r.begin(), part.r.end());
   }
   shares->begin.push_back(Index(shares->mean.size()));
-  t.on_backward(out, [x, mu, shares, s](Tape<T>& t, Var out) {
+  Block<double>* dmu_sums = &scratch.dmu;
+  t.on_backward(out, [x, mu, shares, dmu_sums, s](Tape<T>& t, Var out) {
     const Block<T>& xv = t.value(x);
     const Block<T>& mv = t.value(mu);
     const Block<T>& g = t.grad(out);
@@ -202,8 +232,7 @@ Var mixture_log_density(Tape<T>& t, Var x, Var mu, T sigma, const MixtureDensity
     const Shares& sh = *shares;
     if (t.needs_grad(x)) {
       Block<T>& dx = t.grad(x);
-#pragma omp parallel for schedule(static) if (N > 512)
-      for (Index n = 0; n < N; ++n) {
+      auto pull = [&](Index n) {
         const double px = double(xv(n, 0)), py = double(xv(n, 1));
         double ax = 0, ay = 0;
         for (Index e = sh.begin[size_t(n)]; e < sh.begin[size_t(n + 1)]; ++e) {
@@ -214,10 +243,17 @@ Var mixture_log_density(Tape<T>& t, Var x, Var mu, T sigma, const MixtureDensity
         const double c = -double(g(n, 0)) * inv_s2;
         dx(n, 0) += T(c * ax);
         dx(n, 1) += T(c * ay);
+      };
+      if (N <= 512 || region_would_be_serial()) {
+        for (Index n = 0; n < N; ++n) pull(n);
+      } else {
+#pragma omp parallel for schedule(static)
+        for (Index n = 0; n < N; ++n) pull(n);
       }
     }
     if (t.needs_grad(mu)) {
-      Block<double> dmu = Block<double>::Zero(mv.rows(), 2);
+      Block<double>& dmu = *dmu_sums;
+      dmu.setZero(mv.rows(), 2);
       for (Index n = 0; n < N; ++n) {
         const double px = double(xv(n, 0)), py = double(xv(n, 1));
         const double c = double(g(n, 0)) * inv_s2;

@@ -9,10 +9,14 @@
 // exact terms, so keeping them only helps.
 #include "losses/repulsion.h"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
+
+#include "engine/parallel.h"
 
 namespace jsa {
 
@@ -69,7 +73,8 @@ struct Grid {
 // r_c relative to the spread would give a huge grid of empty cells, so the cell
 // count is capped near 4 K by doubling h (any h is correct, larger just scans more).
 template <class T>
-void build_grid(const Block<T>& mu, double r_c, Grid& g, std::vector<T>& xs, std::vector<T>& ys) {
+void build_grid(const Block<T>& mu, double r_c, Grid& g, std::vector<T>& xs, std::vector<T>& ys,
+                std::vector<Index>& fill) {
   const Index K = mu.rows();
   g.x0 = double(mu.col(0).minCoeff());
   g.y0 = double(mu.col(1).minCoeff());
@@ -89,7 +94,7 @@ void build_grid(const Block<T>& mu, double r_c, Grid& g, std::vector<T>& xs, std
   g.order.resize(K);
   xs.resize(K);
   ys.resize(K);
-  std::vector<Index> fill(g.start.begin(), g.start.end() - 1);
+  fill.assign(g.start.begin(), g.start.end() - 1);
   for (Index i = 0; i < K; ++i) {  // stable: equal cells keep the original order
     const Index at = fill[g.cell_of[i]]++;
     g.order[at] = i;
@@ -98,7 +103,35 @@ void build_grid(const Block<T>& mu, double r_c, Grid& g, std::vector<T>& xs, std
   }
 }
 
+// Everything the cut-off sum needs besides its inputs. The tape op keeps one
+// on its tape (Tape::workspace), so a step of the same K allocates nothing;
+// the per-thread candidate lists only grow.
+template <class T>
+struct RepulsionScratch {
+  using Array = Eigen::Array<T, Eigen::Dynamic, 1>;
+  Grid grid;
+  std::vector<T> xs, ys;  // coordinates in sorted order
+  std::vector<Index> fill;
+  std::vector<double> rows;
+  struct Candidates {
+    Array x, y, d, w;  // the candidates' coordinates, then d_ij and w_ij of one mean
+  };
+  std::vector<Candidates> per_thread;
+};
+
+template <class T>
+double repulsion_cutoff_in(const Block<T>& mu, T sigma, Block<T>* dmu, const RepulsionOptions& o,
+                           RepulsionScratch<T>& scratch);
+
 }  // namespace
+
+template <class T>
+double repulsion_cutoff(const Block<T>& mu, T sigma, Block<T>* dmu, const RepulsionOptions& o) {
+  RepulsionScratch<T> scratch;
+  return repulsion_cutoff_in(mu, sigma, dmu, o, scratch);
+}
+
+namespace {
 
 // Per mean i (one thread writes row i, sums in a fixed order):
 //   row_i = sum_j w_ij,  w_ij = exp(-d_ij / sigma)
@@ -113,7 +146,8 @@ void build_grid(const Block<T>& mu, double r_c, Grid& g, std::vector<T>& xs, std
 // mu_i - mu_j = 0, so w / max(d, tiny) times it is 0 (tiny = the smallest
 // normal T; only a d_ij below it would be mis-scaled).
 template <class T>
-double repulsion_cutoff(const Block<T>& mu, T sigma, Block<T>* dmu, const RepulsionOptions& o) {
+double repulsion_cutoff_in(const Block<T>& mu, T sigma, Block<T>* dmu, const RepulsionOptions& o,
+                           RepulsionScratch<T>& scratch) {
   JSA_CHECK(mu.cols() == 2,
             "repulsion: mu is " << mu.rows() << " x " << mu.cols() << ", not K x 2");
   JSA_CHECK(sigma > 0, "repulsion: sigma = " << sigma);
@@ -126,9 +160,10 @@ double repulsion_cutoff(const Block<T>& mu, T sigma, Block<T>* dmu, const Repuls
   // inside r_c.
   const double r_c = double(sigma) * std::log(1.0 / o.tolerance) * (1 + 1e-9);
 
-  Grid g;
-  std::vector<T> xs, ys;  // coordinates in sorted order
-  build_grid(mu, r_c, g, xs, ys);
+  Grid& g = scratch.grid;
+  std::vector<T>& xs = scratch.xs;  // coordinates in sorted order
+  std::vector<T>& ys = scratch.ys;
+  build_grid(mu, r_c, g, xs, ys, scratch.fill);
 
   using Array = Eigen::Array<T, Eigen::Dynamic, 1>;
   using ConstMap = Eigen::Map<const Array>;
@@ -136,52 +171,68 @@ double repulsion_cutoff(const Block<T>& mu, T sigma, Block<T>* dmu, const Repuls
   const double inv_k2 = 1.0 / (double(K) * double(K));
   const T grad_scale = T(-2.0 / double(sigma) * inv_k2);
   const Index reach = Index(r_c / g.h) + 1;  // rows and columns a cell can see
-  std::vector<double> rows(K);
+  std::vector<double>& rows = scratch.rows;
+  rows.assign(size_t(K), 0.0);
+  if (scratch.per_thread.size() < size_t(max_threads()))
+    scratch.per_thread.resize(size_t(max_threads()));
 
-#pragma omp parallel if (K > 1024)
-  {
-    // Per-thread scratch, grown when a cell needs more, never shrunk:
-    // the candidates' coordinates, then d_ij and w_ij of one mean.
-    Array cand_x, cand_y, d, w;
+  // One cell's means, with a thread's candidate lists (per-thread scratch,
+  // grown when a cell needs more, never shrunk, kept from step to step: the
+  // candidates' coordinates, then d_ij and w_ij of one mean; only the first n
+  // entries of a cell's lists are read).
+  using Candidates = typename RepulsionScratch<T>::Candidates;
+  auto cell_pass = [&](Candidates& own, Index c) {
+    Array &cand_x = own.x, &cand_y = own.y, &d = own.d, &w = own.w;
+    if (g.start[c] == g.start[c + 1]) return;
+    const Index cx = c % g.nx, cy = c / g.nx;
+    Index n = 0;  // candidates gathered so far
+    for (Index ry = std::max<Index>(0, cy - reach); ry <= std::min(g.ny - 1, cy + reach); ++ry) {
+      const double gap = double(std::max<Index>(0, std::abs(ry - cy) - 1)) * g.h;
+      if (gap > r_c) continue;
+      // max(0, .): with gap = r_c, a fused multiply-add can leave -tiny here
+      const Index span = Index(std::sqrt(std::max(0.0, r_c * r_c - gap * gap)) / g.h) + 1;
+      const Index first = g.start[ry * g.nx + std::max<Index>(0, cx - span)];
+      const Index last = g.start[ry * g.nx + std::min(g.nx - 1, cx + span) + 1];
+      const Index m = last - first;
+      if (n + m > cand_x.size()) {
+        cand_x.conservativeResize(2 * (n + m));
+        cand_y.conservativeResize(2 * (n + m));
+      }
+      cand_x.segment(n, m) = ConstMap(xs.data() + first, m);
+      cand_y.segment(n, m) = ConstMap(ys.data() + first, m);
+      n += m;
+    }
+    if (n > d.size()) {
+      d.resize(cand_x.size());
+      w.resize(cand_x.size());
+    }
+    auto d_n = d.head(n), w_n = w.head(n);
+    for (Index s = g.start[c]; s < g.start[c + 1]; ++s) {
+      const Index i = g.order[s];
+      const auto dx = xs[s] - cand_x.head(n);  // mu_i - mu_j, as expressions
+      const auto dy = ys[s] - cand_y.head(n);
+      d_n = (dx.square() + dy.square()).sqrt();
+      w_n = (d_n * -inv_sigma).exp();
+      rows[i] = double(w_n.sum());
+      if (dmu) {
+        w_n /= d_n.max(tiny);  // now w_ij / d_ij
+        (*dmu)(i, 0) = grad_scale * (w_n * dx).sum();
+        (*dmu)(i, 1) = grad_scale * (w_n * dy).sum();
+      }
+    }
+  };
+  // Row i is written by one thread and its sums run in a fixed order, so the
+  // split does not matter; inside another team (region_would_be_serial) the
+  // cells run inline, without a region of one thread.
+  const Index cells = g.nx * g.ny;
+  if (K <= 1024 || region_would_be_serial()) {
+    for (Index c = 0; c < cells; ++c) cell_pass(scratch.per_thread[0], c);
+  } else {
+#pragma omp parallel
+    {
+      Candidates& own = scratch.per_thread[size_t(omp_get_thread_num())];
 #pragma omp for schedule(dynamic, 4)
-    for (Index c = 0; c < g.nx * g.ny; ++c) {
-      if (g.start[c] == g.start[c + 1]) continue;
-      const Index cx = c % g.nx, cy = c / g.nx;
-      Index n = 0;  // candidates gathered so far
-      for (Index ry = std::max<Index>(0, cy - reach); ry <= std::min(g.ny - 1, cy + reach); ++ry) {
-        const double gap = double(std::max<Index>(0, std::abs(ry - cy) - 1)) * g.h;
-        if (gap > r_c) continue;
-        // max(0, .): with gap = r_c, a fused multiply-add can leave -tiny here
-        const Index span = Index(std::sqrt(std::max(0.0, r_c * r_c - gap * gap)) / g.h) + 1;
-        const Index first = g.start[ry * g.nx + std::max<Index>(0, cx - span)];
-        const Index last = g.start[ry * g.nx + std::min(g.nx - 1, cx + span) + 1];
-        const Index m = last - first;
-        if (n + m > cand_x.size()) {
-          cand_x.conservativeResize(2 * (n + m));
-          cand_y.conservativeResize(2 * (n + m));
-        }
-        cand_x.segment(n, m) = ConstMap(xs.data() + first, m);
-        cand_y.segment(n, m) = ConstMap(ys.data() + first, m);
-        n += m;
-      }
-      if (n > d.size()) {
-        d.resize(cand_x.size());
-        w.resize(cand_x.size());
-      }
-      auto d_n = d.head(n), w_n = w.head(n);
-      for (Index s = g.start[c]; s < g.start[c + 1]; ++s) {
-        const Index i = g.order[s];
-        const auto dx = xs[s] - cand_x.head(n);  // mu_i - mu_j, as expressions
-        const auto dy = ys[s] - cand_y.head(n);
-        d_n = (dx.square() + dy.square()).sqrt();
-        w_n = (d_n * -inv_sigma).exp();
-        rows[i] = double(w_n.sum());
-        if (dmu) {
-          w_n /= d_n.max(tiny);  // now w_ij / d_ij
-          (*dmu)(i, 0) = grad_scale * (w_n * dx).sum();
-          (*dmu)(i, 1) = grad_scale * (w_n * dy).sum();
-        }
-      }
+      for (Index c = 0; c < cells; ++c) cell_pass(own, c);
     }
   }
   double total = 0;
@@ -189,14 +240,17 @@ double repulsion_cutoff(const Block<T>& mu, T sigma, Block<T>* dmu, const Repuls
   return total * inv_k2;
 }
 
+}  // namespace
+
 // Forward stores dL/dmu in a helper node (storage reused across steps);
 // pull-back: dmu += dL * (dL_rep/dmu).
 template <class T>
 Var repulsion(Tape<T>& t, Var mu, T sigma, const RepulsionOptions& o) {
   const bool want_grad = t.needs_grad(mu);
-  Var dmu_store = t.node(t.rows(mu), 2, std::initializer_list<Var>{});
+  Var dmu_store = t.node(t.rows(mu), 2, {});
   const double value =
-      repulsion_cutoff(t.value(mu), sigma, want_grad ? &t.value(dmu_store) : nullptr, o);
+      repulsion_cutoff_in(t.value(mu), sigma, want_grad ? &t.value(dmu_store) : nullptr, o,
+                          t.template workspace<RepulsionScratch<T>>());
   Var out = t.node(1, 1, {mu});
   t.value(out)(0, 0) = T(value);
   t.on_backward(out, [mu, dmu_store](Tape<T>& t, Var out) {

@@ -33,14 +33,14 @@ template <class T>
 Var Atlas<T>::phi_code(Tape<T>& t, int shape) {
   if (phi_codes_ < 0) return Var{};
   JSA_CHECK(shape >= 0 && shape < options_.shapes, "shape " << shape << " of " << options_.shapes);
-  return gather_rows(t, params.on(t, phi_codes_), {shape});
+  return slice_rows(t, params.on(t, phi_codes_), shape, 1);  // row `shape` (no index vector)
 }
 
 template <class T>
 Var Atlas<T>::psi_code(Tape<T>& t, int shape) {
   if (psi_codes_ < 0) return Var{};
   JSA_CHECK(shape >= 0 && shape < options_.shapes, "shape " << shape << " of " << options_.shapes);
-  return gather_rows(t, params.on(t, psi_codes_), {shape});
+  return slice_rows(t, params.on(t, psi_codes_), shape, 1);  // row `shape` (no index vector)
 }
 
 template <class T>

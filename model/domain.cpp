@@ -25,8 +25,12 @@ void Domain<T>::initialize(Parameters<T>& params, Rng& rng) const {
 template <class T>
 Var Domain<T>::sample(Tape<T>& t, Parameters<T>& params, Index count, Rng& rng,
                       std::vector<int>* component) const {
-  std::vector<int> index(static_cast<size_t>(count));
-  Block<T> noise(count, 2);
+  // The draws go straight into tape storage: the components into a vector the
+  // tape keeps for this op (workspace), the noise into its constant node.
+  std::vector<int>& index = t.template workspace<std::vector<int>>();
+  index.resize(static_cast<size_t>(count));
+  const Var noise_node = t.constant(Block<T>::Zero(count, 2));
+  Block<T>& noise = t.value(noise_node);
   for (Index m = 0; m < count; ++m) {
     index[m] = int(rng.below(uint64_t(options_.gaussians)));
     noise(m, 0) = options_.gaussian_noise ? T(sigma_ * rng.normal()) : T(0);
@@ -34,7 +38,7 @@ Var Domain<T>::sample(Tape<T>& t, Parameters<T>& params, Index count, Rng& rng,
   }
   if (component) *component = index;
   Var mu = params.on(t, mu_);
-  return add(t, gather_rows(t, mu, index), t.constant(noise));
+  return add(t, gather_rows(t, mu, index), noise_node);
 }
 
 template <class T>

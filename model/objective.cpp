@@ -25,16 +25,36 @@ Components Components::table_row(int row) {
 
 namespace {
 
+// A constant copy of node v (no gradient flows back through it). The node is
+// made first and filled after: appending it may move the block v names.
+template <class T>
+Var held_constant(Tape<T>& t, Var v) {
+  const Var c = t.constant(Block<T>::Zero(t.rows(v), t.cols(v)));
+  t.value(c) = t.value(v);
+  return c;
+}
+
 // phi_t(x_P) of the reference shape t, on the values alone (x_P and t's code
 // held constant): the key of a look-up (L_6D^h's h_t, L_map's T_i) that is a
-// constant of the step, so backward never reaches this pass.
+// constant of the step, so backward never reaches this pass. The block is the
+// tape's: read it before the next node is made.
 template <class T>
-Block<T> reference_points(Tape<T>& t, Atlas<T>& atlas, Var x_p, int reference) {
-  const Var x_fixed = t.constant(Block<T>(t.value(x_p)));
-  const Var code_t =
-      atlas.has_codes() ? t.constant(Block<T>(t.value(atlas.phi_code(t, reference)))) : Var{};
+const Block<T>& reference_points(Tape<T>& t, Atlas<T>& atlas, Var x_p, int reference) {
+  const Var x_fixed = held_constant(t, x_p);
+  const Var code_t = atlas.has_codes() ? held_constant(t, atlas.phi_code(t, reference)) : Var{};
   return t.value(atlas.phi.evaluate(t, atlas.params, x_fixed, false, code_t).points);
 }
+
+// The weighted terms of L_single (Eq. 5), at most one of each kind: a fixed
+// array, not a vector (nothing in a step may allocate).
+struct WeightedTerms {
+  std::pair<double, Var> term[10];
+  int count = 0;
+  void push_back(std::pair<double, Var> t) {
+    JSA_CHECK(count < 10, "more loss terms than WeightedTerms holds");
+    term[count++] = t;
+  }
+};
 
 }  // namespace
 
@@ -51,11 +71,11 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
   JSA_CHECK(!intrinsic || c.normals, "L_6D^h needs the normals in the loss");
   Parameters<T>& p = atlas.params;
   LossTerms out;
-  std::vector<std::pair<double, Var>> weighted;  // (lambda, term)
+  WeightedTerms weighted;  // (lambda, term)
 
   // {x_P} ~ P by the reparameterization trick (Eq. 4).
   const Var x_p = atlas.domain.sample(t, p, m, rng);  // M x 2
-  const Var s6 = t.constant(intrinsic ? Block<T>(targets.leftCols(6)) : targets);
+  const Var s6 = intrinsic ? t.constant(targets.leftCols(6)) : t.constant(targets);
   const Var f_phi = atlas.phi_code(t, shape), f_psi = atlas.psi_code(t, shape);
   const bool jacobian = c.normals || c.isometry || c.chart;
 
@@ -84,11 +104,11 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
     // L_6D^h (objective.h): beta h_t(phi_t(x_P)), the reference's descriptor
     // where its surface puts x_P, a constant of the step. phi_t runs on the
     // values alone: nothing downstream reaches the loss, so backward skips it.
-    std::vector<int> near;
+    std::vector<int>& near = t.template workspace<std::vector<int>>();
     intrinsic->surface->query(reference_points(t, atlas, x_p, intrinsic->reference), near);
-    Block<T> h(m, intrinsic->descriptors->cols());
-    for (Index i = 0; i < m; ++i) h.row(i) = intrinsic->descriptors->row(near[size_t(i)]);
-    generated = concat_cols(t, {generated, t.constant(h)});
+    const Var h = t.constant(Block<T>::Zero(m, intrinsic->descriptors->cols()));
+    for (Index i = 0; i < m; ++i) t.value(h).row(i) = intrinsic->descriptors->row(near[size_t(i)]);
+    generated = concat_cols(t, {generated, h});
     sampled = t.constant(targets);
   }
   ChamferMatches<T>* const no_matches = nullptr;
@@ -131,7 +151,7 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
     // The reference's code is held constant here: it is a target for the
     // others, moved only by its own shape's terms (which also keeps a
     // data-parallel step exact: a code's gradient stays on its shape's rank).
-    const Var ref_code = t.constant(Block<T>(t.value(atlas.phi_code(t, o.metric_reference))));
+    const Var ref_code = held_constant(t, atlas.phi_code(t, o.metric_reference));
     const SurfacePoints ref = atlas.phi.evaluate(t, p, x_p, true, ref_code);
     const Var metric =
         o.metric_conformal
@@ -142,12 +162,12 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
   if (w.map > 0 && map && shape != map->reference) {
     // L_map (objective.h): T_i(phi_t(x_P)) a constant of the step, phi_t on
     // the values alone (as L_6D^h's h_t above).
-    std::vector<int> near;
+    std::vector<int>& near = t.template workspace<std::vector<int>>();
     map->surface->query(reference_points(t, atlas, x_p, map->reference), near);
     const Block<T>& image = (*map->images)[size_t(shape)];
-    Block<T> y(m, 3);
-    for (Index i = 0; i < m; ++i) y.row(i) = image.row(near[size_t(i)]);
-    const Var pull = mean_squared_distance(t, first_m(all.points), t.constant(y));
+    const Var y = t.constant(Block<T>::Zero(m, 3));
+    for (Index i = 0; i < m; ++i) t.value(y).row(i) = image.row(near[size_t(i)]);
+    const Var pull = mean_squared_distance(t, first_m(all.points), y);
     weighted.push_back({w.map, pull});
     out.map = double(t.scalar(pull));
   }
@@ -160,9 +180,9 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
   }
 
   // L_single = sum of lambda * L   (Eq. 5)
-  Var total = scale(t, weighted[0].second, T(weighted[0].first));
-  for (size_t k = 1; k < weighted.size(); ++k)
-    total = add(t, total, scale(t, weighted[k].second, T(weighted[k].first)));
+  Var total = scale(t, weighted.term[0].second, T(weighted.term[0].first));
+  for (int k = 1; k < weighted.count; ++k)
+    total = add(t, total, scale(t, weighted.term[k].second, T(weighted.term[k].first)));
   out.total = double(t.scalar(total));
   if (terms) *terms = out;
   return total;

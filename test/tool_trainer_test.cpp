@@ -500,6 +500,7 @@ TEST_CASE("trainer: L_even from evenness_from of the run; until then the run wit
           "[trainer]") {
   FitOptions o = small_options();
   o.iterations = 6;
+  o.weights.evenness = 0;  // the run without it (L_even is on by default since f4d94f5)
   FitOptions even = o;
   even.weights.evenness = 1e-2;
   even.evenness_from = 0.5;

@@ -12,6 +12,7 @@
 #include <nanoflann.hpp>
 
 #include "engine/check.h"
+#include "engine/parallel.h"
 
 namespace jsa {
 namespace {
@@ -114,20 +115,22 @@ uint64_t spread_bits_by_3(uint64_t v) {
 // arrive in the random order of the domain's samples. Every query's answer is
 // its own (ties go to the lowest index, whatever the order), so the order
 // changes no result, only the time.
+// order and code are the caller's (kept between calls by a NearestScratch).
 template <class T>
-std::vector<Index> locality_order(const Block<T>& queries) {
+void locality_order(const Block<T>& queries, std::vector<Index>& order,
+                    std::vector<uint64_t>& code) {
   const Index m = queries.rows();
-  std::vector<Index> order(static_cast<size_t>(m));
+  order.resize(static_cast<size_t>(m));
   for (Index i = 0; i < m; ++i) order[size_t(i)] = i;
   const Index dims = std::min<Index>(3, queries.cols());
-  if (m < 64 || dims < 2) return order;  // too few to gain from it
+  if (m < 64 || dims < 2) return;  // too few to gain from it
   double lo[3] = {0, 0, 0}, scale[3] = {0, 0, 0};
   for (Index d = 0; d < dims; ++d) {
     lo[d] = double(queries.col(d).minCoeff());
     const double width = double(queries.col(d).maxCoeff()) - lo[d];
     scale[d] = width > 0 ? double((1 << 21) - 1) / width : 0;
   }
-  std::vector<uint64_t> code(static_cast<size_t>(m));
+  code.resize(static_cast<size_t>(m));
   for (Index i = 0; i < m; ++i) {
     uint64_t c = 0;
     for (Index d = 0; d < dims; ++d) {
@@ -141,35 +144,73 @@ std::vector<Index> locality_order(const Block<T>& queries) {
   std::sort(order.begin(), order.end(), [&](Index a, Index b) {
     return code[size_t(a)] != code[size_t(b)] ? code[size_t(a)] < code[size_t(b)] : a < b;
   });
-  return order;
 }
+
+// A search's working storage (NearestScratch<T>::Impl holds one per column
+// count): the visiting order, and a tree rebuilt in place over new points.
+template <class T, int Dim>
+struct TreeCache {
+  std::vector<Index> order;
+  std::vector<uint64_t> code;
+  RowsSource<T> source{nullptr, 0, 0};  // the tree reads the points through this
+  std::unique_ptr<KdTree<T, Dim>> tree;
+
+  // The tree over `points`: buildIndex() on the kept tree reuses its index
+  // array (the same build as a new tree's: the index array reset, the bounding
+  // box computed, the nodes split the same way).
+  const KdTree<T, Dim>& build(const Block<T>& points) {
+    const size_t cols = size_t(points.cols());
+    const bool same_cols = source.cols == cols;
+    source = RowsSource<T>{points.data(), size_t(points.rows()), cols};
+    if (tree && same_cols)
+      tree->buildIndex();
+    else
+      tree = build_tree<T, Dim>(source);
+    return *tree;
+  }
+};
 
 template <class T, int Dim>
 void query_tree(const KdTree<T, Dim>& tree, const Block<T>& queries, std::vector<int>& index,
-                std::vector<T>* squared_distance) {
+                std::vector<T>* squared_distance, std::vector<Index>& order,
+                std::vector<uint64_t>& code) {
   const nanoflann::SearchParams params;  // eps = 0: exact search
   const Index m = queries.rows();
   const T* q = queries.data();
   const size_t c = size_t(queries.cols());
   T* dist = squared_distance ? squared_distance->data() : nullptr;
-  const std::vector<Index> order = locality_order(queries);
-  // Small batches stay serial: a parallel region costs more than it saves, and
-  // far more when another process holds the second core.
-#pragma omp parallel for schedule(dynamic, 256) if (m > 1024)
-  for (Index j = 0; j < m; ++j) {
+  locality_order(queries, order, code);
+  auto answer = [&](Index j) {
     const Index i = order[size_t(j)];
     ClosestOne<T> best;
     tree.findNeighbors(best, q + size_t(i) * c, params);
     index[i] = int(best.index());
     if (dist) dist[i] = best.distance();
+  };
+  // Small batches stay serial: a parallel region costs more than it saves, and
+  // far more when another process holds the second core; so do searches inside
+  // another team (the trainer's shape workers), where a region would have one
+  // thread and cost a heap block (engine/parallel.h, region_would_be_serial).
+  if (m <= 1024 || region_would_be_serial()) {
+    for (Index j = 0; j < m; ++j) answer(j);
+    return;
   }
+#pragma omp parallel for schedule(dynamic, 256)
+  for (Index j = 0; j < m; ++j) answer(j);
 }
 
 template <class T, int Dim>
 void nearest_kdtree(const Block<T>& queries, const Block<T>& points, std::vector<int>& index,
-                    std::vector<T>* squared_distance) {
+                    std::vector<T>* squared_distance, TreeCache<T, Dim>* cache) {
+  if (cache) {
+    const KdTree<T, Dim>& tree = cache->build(points);
+    query_tree<T, Dim>(tree, queries, index, squared_distance, cache->order, cache->code);
+    return;
+  }
   const RowsSource<T> source{points.data(), size_t(points.rows()), size_t(points.cols())};
-  query_tree<T, Dim>(*build_tree<T, Dim>(source), queries, index, squared_distance);
+  std::vector<Index> order;
+  std::vector<uint64_t> code;
+  query_tree<T, Dim>(*build_tree<T, Dim>(source), queries, index, squared_distance, order, code);
 }
 
 // `points_checked`: the points' finiteness was checked when their index was built
@@ -187,23 +228,43 @@ void check_shapes(const Block<T>& queries, const Block<T>& points, bool points_c
 
 }  // namespace
 
+// One cache per column count nearest() fixes at compile time.
+template <class T>
+struct NearestScratch<T>::Impl {
+  TreeCache<T, 2> d2;
+  TreeCache<T, 3> d3;
+  TreeCache<T, 6> d6;
+  TreeCache<T, 9> d9;
+  TreeCache<T, -1> any;
+};
+
+template <class T>
+NearestScratch<T>::NearestScratch() : impl_(std::make_unique<Impl>()) {}
+template <class T>
+NearestScratch<T>::~NearestScratch() = default;
+template <class T>
+NearestScratch<T>::NearestScratch(NearestScratch&&) noexcept = default;
+template <class T>
+NearestScratch<T>& NearestScratch<T>::operator=(NearestScratch&&) noexcept = default;
+
 template <class T>
 void nearest(const Block<T>& queries, const Block<T>& points, std::vector<int>& index,
-             std::vector<T>* squared_distance) {
+             std::vector<T>* squared_distance, NearestScratch<T>* scratch) {
   check_shapes(queries, points);
   index.resize(queries.rows());
   if (squared_distance) squared_distance->resize(queries.rows());
+  typename NearestScratch<T>::Impl* s = scratch ? &scratch->impl() : nullptr;
   switch (points.cols()) {
     case 2:
-      return nearest_kdtree<T, 2>(queries, points, index, squared_distance);
+      return nearest_kdtree<T, 2>(queries, points, index, squared_distance, s ? &s->d2 : nullptr);
     case 3:
-      return nearest_kdtree<T, 3>(queries, points, index, squared_distance);
+      return nearest_kdtree<T, 3>(queries, points, index, squared_distance, s ? &s->d3 : nullptr);
     case 6:
-      return nearest_kdtree<T, 6>(queries, points, index, squared_distance);
+      return nearest_kdtree<T, 6>(queries, points, index, squared_distance, s ? &s->d6 : nullptr);
     case 9:  // L_6D with the intrinsic descriptors (io/geometry/intrinsic_descriptors.h)
-      return nearest_kdtree<T, 9>(queries, points, index, squared_distance);
+      return nearest_kdtree<T, 9>(queries, points, index, squared_distance, s ? &s->d9 : nullptr);
     default:
-      return nearest_kdtree<T, -1>(queries, points, index, squared_distance);
+      return nearest_kdtree<T, -1>(queries, points, index, squared_distance, s ? &s->any : nullptr);
   }
 }
 
@@ -216,7 +277,9 @@ struct NearestIndex<T>::Impl {
   explicit Impl(Block<T> p)
       : points(std::move(p)), source{points.data(), size_t(points.rows()), size_t(points.cols())} {}
   virtual ~Impl() = default;
-  virtual void query(const Block<T>& q, std::vector<int>& index, std::vector<T>* d) const = 0;
+  // order and code: the visiting order's storage (a NearestScratch's, or the call's own).
+  virtual void query(const Block<T>& q, std::vector<int>& index, std::vector<T>* d,
+                     std::vector<Index>& order, std::vector<uint64_t>& code) const = 0;
 };
 
 namespace {
@@ -225,8 +288,9 @@ struct TreeImpl final : NearestIndex<T>::Impl {
   std::unique_ptr<KdTree<T, Dim>> tree;
   explicit TreeImpl(Block<T> p)
       : NearestIndex<T>::Impl(std::move(p)), tree(build_tree<T, Dim>(this->source)) {}
-  void query(const Block<T>& q, std::vector<int>& index, std::vector<T>* d) const override {
-    query_tree<T, Dim>(*tree, q, index, d);
+  void query(const Block<T>& q, std::vector<int>& index, std::vector<T>* d,
+             std::vector<Index>& order, std::vector<uint64_t>& code) const override {
+    query_tree<T, Dim>(*tree, q, index, d, order, code);
   }
 };
 }  // namespace
@@ -262,11 +326,18 @@ NearestIndex<T>& NearestIndex<T>::operator=(NearestIndex&&) noexcept = default;
 
 template <class T>
 void NearestIndex<T>::query(const Block<T>& queries, std::vector<int>& index,
-                            std::vector<T>* squared_distance) const {
+                            std::vector<T>* squared_distance, NearestScratch<T>* scratch) const {
   check_shapes(queries, impl_->points, /*points_checked=*/true);
   index.resize(queries.rows());
   if (squared_distance) squared_distance->resize(queries.rows());
-  impl_->query(queries, index, squared_distance);
+  if (scratch) {  // the order's storage of the generic cache (no tree of its own is built)
+    auto& cache = scratch->impl().any;
+    impl_->query(queries, index, squared_distance, cache.order, cache.code);
+    return;
+  }
+  std::vector<Index> order;
+  std::vector<uint64_t> code;
+  impl_->query(queries, index, squared_distance, order, code);
 }
 
 template <class T>
@@ -299,10 +370,12 @@ void nearest_brute_force(const Block<T>& queries, const Block<T>& points, std::v
   }
 }
 
-#define JSA_INSTANTIATE(T)                                                                        \
-  template void nearest<T>(const Block<T>&, const Block<T>&, std::vector<int>&, std::vector<T>*); \
-  template void nearest_brute_force<T>(const Block<T>&, const Block<T>&, std::vector<int>&,       \
-                                       std::vector<T>*);                                          \
+#define JSA_INSTANTIATE(T)                                                                       \
+  template class NearestScratch<T>;                                                              \
+  template void nearest<T>(const Block<T>&, const Block<T>&, std::vector<int>&, std::vector<T>*, \
+                           NearestScratch<T>*);                                                  \
+  template void nearest_brute_force<T>(const Block<T>&, const Block<T>&, std::vector<int>&,      \
+                                       std::vector<T>*);                                         \
   template class NearestIndex<T>;
 JSA_INSTANTIATE(float)
 JSA_INSTANTIATE(double)

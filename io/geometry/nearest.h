@@ -19,9 +19,32 @@ namespace jsa {
 // index[i] = argmin_j |queries_i - points_j|^2, and if squared_distance is given
 // it holds the M minimal squared distances. All coordinates must be finite.
 // Tuned (fixed-size code) for C = 2, 3, 6, 9; other C take a generic path.
+template <class NearestScalar>
+class NearestScratch;
 template <class T>
 void nearest(const Block<T>& queries, const Block<T>& points, std::vector<int>& index,
-             std::vector<T>* squared_distance = nullptr);
+             std::vector<T>* squared_distance = nullptr, NearestScratch<T>* scratch = nullptr);
+
+// What a search needs besides its answer, for a caller that searches every
+// step (the Chamfer op keeps one per search on its tape): the queries' visiting
+// order and, for nearest(), the tree over `points`, rebuilt in place. With one,
+// a search of the same sizes as the last allocates only the blocks nanoflann's
+// node pool frees and takes again at every build (a few of 8 KiB); without,
+// each call builds its own. Not shared between threads.
+template <class T>
+class NearestScratch {
+ public:
+  NearestScratch();
+  ~NearestScratch();
+  NearestScratch(NearestScratch&&) noexcept;
+  NearestScratch& operator=(NearestScratch&&) noexcept;
+
+  struct Impl;  // defined in nearest.cpp
+  Impl& impl() { return *impl_; }
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
 
 // The oracle: the obvious O(M N) double loop, same contract as nearest().
 template <class T>
@@ -40,7 +63,8 @@ class NearestIndex {
   NearestIndex& operator=(NearestIndex&&) noexcept;
 
   void query(const Block<T>& queries, std::vector<int>& index,
-             std::vector<T>* squared_distance = nullptr) const;
+             std::vector<T>* squared_distance = nullptr,
+             NearestScratch<T>* scratch = nullptr) const;
   const Block<T>& points() const;
 
   struct Impl;  // the tree; defined in nearest.cpp, where nanoflann lives

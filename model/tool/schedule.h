@@ -51,9 +51,11 @@ inline Index scheduled_points(const ScheduleOptions& s, Index points, int64_t i,
 // warmup * n iterations.
 inline double scheduled_lr(const ScheduleOptions& s, double lr, const std::vector<double>& decay_at,
                            double decay, int64_t i, int64_t n) {
-  std::vector<int64_t> milestones;
-  for (double f : decay_at) milestones.push_back(int64_t(std::llround(f * double(n))));
-  double r = step_decay(lr, i, milestones, decay);
+  // step_decay over the milestones round(f n), counted in place (the trainer
+  // asks every step, and a step allocates nothing).
+  double r = lr;
+  for (double f : decay_at)
+    if (i >= int64_t(std::llround(f * double(n)))) r *= decay;
   const double w = s.warmup * double(n);
   if (w >= 1 && double(i) < w) r *= 0.1 + 0.9 * double(i) / w;
   return r;

@@ -211,7 +211,8 @@ void Trainer::step() {
   if (b < n) {
     // A uniform subset of B shapes: the first B of a partial Fisher-Yates shuffle
     // (the same on every rank: rng_ is).
-    std::vector<int> order(static_cast<size_t>(n));
+    std::vector<int>& order = batch_order_;  // kept: no allocation in a step
+    order.resize(static_cast<size_t>(n));
     for (int i = 0; i < n; ++i) order[size_t(i)] = i;
     for (int i = 0; i < b; ++i)
       std::swap(order[size_t(i)], order[size_t(i) + rng_.below(uint64_t(n - i))]);
@@ -429,12 +430,22 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
   }
   worker_targets_.resize(size_t(workers));
   shape_threads_ = workers;
-  std::vector<LossTerms> part(static_cast<size_t>(workers));
-  std::vector<std::exception_ptr> failure(static_cast<size_t>(workers));
+  // Per worker: its loss terms, its exception, its share of the objective;
+  // members, cleared not freed, so that a step allocates nothing.
+  std::vector<LossTerms>& part = worker_terms_;
+  std::vector<std::exception_ptr>& failure = worker_failures_;
+  part.assign(size_t(workers), LossTerms{});
+  failure.assign(size_t(workers), nullptr);
+  worker_shares_.resize(size_t(workers));
   atlas_->params.zero_grad();
   auto work = [&](int w) {
     const int begin = count * w / workers, end = count * (w + 1) / workers;
-    ObjectiveShare<float> share;
+    ObjectiveShare<float>& share = worker_shares_[size_t(w)];
+    share.shapes.clear();
+    share.rngs.clear();
+    share.surfaces.clear();
+    share.intrinsic = nullptr;
+    share.map = nullptr;
     share.batch = b;
     share.repulsion = first_shape_ == 0 && w == 0;  // rank 0: N l_rep L_rep is counted once
     share.code_begin = w == 0 ? first_shape_ : 0;
@@ -538,16 +549,17 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
   // theta <- old + s (theta_Adam - old): the codes (code_lr_scale) and, in the
   // joint training of a deformed collection, the shared surface phi
   // (surface_lr_scale; its parameters are "phi.*" but not D's "phi.deform.*").
-  struct Held {
-    size_t offset;
-    float scale;
-    std::vector<float> old;
-  };
-  std::vector<Held> held;
+  // (held_: a member, its entries' storage reused from step to step)
+  std::vector<Held>& held = held_;
+  size_t held_count = 0;
   auto hold = [&](int index, double scale) {
     const auto& e = atlas_->params.entry(index);
     const float* v = atlas_->params.values().data() + e.offset;
-    held.push_back({size_t(e.offset), float(scale), std::vector<float>(v, v + e.rows * e.cols)});
+    if (held_count == held.size()) held.emplace_back();
+    Held& h = held[held_count++];
+    h.offset = size_t(e.offset);
+    h.scale = float(scale);
+    h.old.assign(v, v + e.rows * e.cols);
   };
   if (options_.code_lr_scale != 1 && atlas_->has_codes())
     for (const char* name : {"codes.phi", "codes.psi"})
@@ -559,7 +571,8 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
         hold(i, options_.surface_lr_scale);
     }
   adam_.step(atlas_->params, lr);
-  for (const Held& h : held) {
+  for (size_t j = 0; j < held_count; ++j) {
+    const Held& h = held[j];
     float* v = atlas_->params.values().data() + h.offset;
     for (size_t k = 0; k < h.old.size(); ++k) v[k] = h.old[k] + h.scale * (v[k] - h.old[k]);
   }

@@ -6,6 +6,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <stdexcept>
@@ -414,6 +415,19 @@ class Trainer {
   std::vector<Tape<float>> worker_tapes_;
   std::vector<std::vector<float>> worker_grads_;
   std::vector<std::vector<Block<float>>> worker_targets_;  // each thread's copy of its targets
+  // Per worker of the last step: its loss terms, its exception, its share of
+  // the objective (members so that a step allocates nothing: train_on).
+  std::vector<LossTerms> worker_terms_;
+  std::vector<std::exception_ptr> worker_failures_;
+  std::vector<ObjectiveShare<float>> worker_shares_;
+  std::vector<int> batch_order_;  // the shuffle that draws a batch of shapes
+  // Parameters under a per-group rate, before Adam's step (train_on).
+  struct Held {
+    size_t offset = 0;
+    float scale = 1;
+    std::vector<float> old;
+  };
+  std::vector<Held> held_;
   int shape_threads_ = 1;
   Rng rng_;
   int64_t iteration_ = 0;
