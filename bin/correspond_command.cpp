@@ -208,8 +208,12 @@ void run_eval_corr(const EvalCorrArgs& a) {
                               const Block<double>& normals) {
     return correspond(*r.atlas, from, to, p, normals, co);
   };
-  if (a.spectral)
+  if (a.spectral) {
     map = spectral_refinement(map, meshes, r.contents.normalizations, a.spectral_options);
+    // Seconds a shape for its eigenfunctions, under one a pair: say so up front.
+    std::fprintf(stderr, "refining by ZoomOut: %zu shapes x %d eigenfunctions, %zu ordered pairs\n",
+                 n, a.spectral_options.functions, n * (n - 1));
+  }
   const KeypointError e = keypoint_error(map, meshes, r.contents.normalizations, keypoints);
   std::string rule = !co.use_chart         ? "nearest-sample rule, no chart"
                      : co.refine_steps > 0 ? "q = phi_J(u), u = psi_I(p) refined by " +

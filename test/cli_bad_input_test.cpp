@@ -94,7 +94,8 @@ TEST_CASE("cli: keypoint indices beyond the mesh are rejected with file and line
   rejects(eval + dir + "/missing.vts", 1, "missing.vts");
   // The spectral refinement on a tetrahedron: fewer vertices than eigenfunctions.
   write_text(dir + "/b.vts", "0\n1\n");
-  rejects(eval + dir + "/b.vts --spectral", 1, "more eigenfunctions than vertices");
+  rejects(eval + dir + "/b.vts --spectral", 1,
+          "shape 0 has 4 vertices, fewer than 60 eigenfunctions (--spectral-functions)");
   rejects(eval + dir + "/b.vts --spectral-functions 1", 2, "--spectral-functions");
 }
 

@@ -70,6 +70,10 @@ CorrespondenceMap spectral_refinement(CorrespondenceMap base, const std::vector<
     if (meshes[s].is_point_cloud())
       throw InputError("the spectral refinement needs triangle meshes (shape " + std::to_string(s) +
                        " is a point cloud)");
+    if (meshes[s].vertices.rows() < Index(o.functions))
+      throw InputError("the spectral refinement: shape " + std::to_string(s) + " has " +
+                       std::to_string(meshes[s].vertices.rows()) + " vertices, fewer than " +
+                       std::to_string(o.functions) + " eigenfunctions (--spectral-functions)");
     Shape shape;
     shape.unit = frames[s].to_unit(meshes[s].vertices);
     shape.normals = frames[s].normals_to_unit(vertex_normals_of(meshes[s]));
