@@ -21,11 +21,13 @@ double match_both_ways(const Block<T>& x, const Block<T>& y, const NearestIndex<
   JSA_CHECK(x.rows() > 0 && y.rows() > 0,
             "chamfer of an empty set: " << x.rows() << " and " << y.rows() << " points");
   JSA_CHECK(x.cols() == y.cols(), "chamfer: " << x.cols() << " vs " << y.cols() << " columns");
-  if (surface)
+  if (surface) {
     surface->query(x, m.x_to_y, &m.x_squared_distance, x_search);
-  else
-    nearest(x, y, m.x_to_y, &m.x_squared_distance, x_search);
-  nearest(y, x, m.y_to_x, &m.y_squared_distance, y_search);
+    nearest(y, x, m.y_to_x, &m.y_squared_distance, y_search);
+  } else {
+    nearest_both_ways(x, y, m.x_to_y, &m.x_squared_distance, m.y_to_x, &m.y_squared_distance,
+                      x_search, y_search);
+  }
   double sx = 0, sy = 0;
   for (T d : m.x_squared_distance) sx += double(d);
   for (T d : m.y_squared_distance) sy += double(d);

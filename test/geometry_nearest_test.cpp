@@ -199,6 +199,66 @@ TEST_CASE("nearest answers each query as its own, whatever the queries' order an
   CHECK(forward == oracle);
 }
 
+TEST_CASE("a scan and a tree give the same answers on either side of the scan's limit",
+          "[nearest]") {
+  // nearest() scans every distance when M N <= 2^24 and searches a kd-tree
+  // above; both must be the oracle's answer, ties to the lowest index.
+  const Block<float> q = points_with_normals<float>(4300, 71),
+                     p = points_with_normals<float>(4000, 72);
+  REQUIRE(double(q.rows()) * double(p.rows()) > double(1 << 24));
+  expect_same_as_brute_force(q, p);                              // the tree
+  expect_same_as_brute_force(Block<float>(q.topRows(1000)), p);  // the scan
+}
+
+TEMPLATE_TEST_CASE("nearest_both_ways gives nearest() in both directions", "[nearest]", float,
+                   double) {
+  // Points 0..299 repeated: every point of x has two equally near points in
+  // y, and every point of y's first copy is tied with its second.
+  const Block<TestType> base = points_with_normals<TestType>(300, 81);
+  Block<TestType> y(600, 6);
+  y << base, base;
+  const Block<TestType> x = points_with_normals<TestType>(700, 82);
+  for (const bool large : {false, true}) {
+    // Large: 4200 x 4200, above the scan's limit, two tree searches.
+    const Block<TestType> a = large ? points_with_normals<TestType>(4200, 83) : x;
+    const Block<TestType> b = large ? points_with_normals<TestType>(4200, 84) : y;
+    std::vector<int> ab, ba, ab_oracle, ba_oracle;
+    std::vector<TestType> dab, dba, dab_oracle, dba_oracle;
+    NearestScratch<TestType> sa, sb;
+    for (int round = 0; round < 2; ++round) {  // the second reuses the scratch
+      INFO("large " << large << ", round " << round);
+      nearest_both_ways(a, b, ab, &dab, ba, &dba, &sa, &sb);
+      nearest_brute_force(a, b, ab_oracle, &dab_oracle);
+      nearest_brute_force(b, a, ba_oracle, &dba_oracle);
+      CHECK(ab == ab_oracle);
+      CHECK(ba == ba_oracle);
+      // The distances are summed with the same terms in the same order, but
+      // the compiler may fuse them differently in the oracle's generic loop.
+      for (size_t i = 0; i < ab.size(); ++i)
+        CHECK(dab[i] == Approx(dab_oracle[i]).epsilon(1e-6).margin(1e-12));
+      for (size_t j = 0; j < ba.size(); ++j)
+        CHECK(dba[j] == Approx(dba_oracle[j]).epsilon(1e-6).margin(1e-12));
+    }
+  }
+}
+
+TEST_CASE("nearest_both_ways does not depend on the thread count", "[nearest]") {
+  const Block<float> x = points_with_normals<float>(2500, 91),
+                     y = points_with_normals<float>(2300, 92);
+  std::vector<int> a1, b1, a2, b2;
+  std::vector<float> da1, db1, da2, db2;
+  const int threads = max_threads();
+  set_threads(1);
+  nearest_both_ways(x, y, a1, &da1, b1, &db1);
+  set_threads(std::max(2, threads));
+  nearest_both_ways(x, y, a2, &da2, b2, &db2);
+  set_threads(threads);
+  CHECK(a1 == a2);
+  CHECK(b1 == b2);
+  CHECK(da1 == da2);
+  CHECK(db1 == db2);
+}
+
 TEST_CASE("nearest timing at training-loop sizes", "[.bench][nearest]") {
   // 10^4 x 10^4 in 2D (L_2D) and 6D (L_6D), float; median of 15 runs.
   auto median_ms = [](auto&& f) {
@@ -229,4 +289,30 @@ TEST_CASE("nearest timing at training-loop sizes", "[.bench][nearest]") {
       "nearest 10^4 x 10^4, %d threads, median of 15: 2D %.2f ms, 6D %.2f ms"
       " (brute force 2D %.1f ms)\n",
       max_threads(), k2, k6, b2);
+
+  // The Chamfer terms' sizes at the default M = 2500: both directions by the
+  // scan (nearest_both_ways) against two kd-trees built and searched
+  // (NearestIndex always uses a tree).
+  for (const Index c : {Index(2), Index(6)}) {
+    const Block<float> x =
+        c == 6 ? points_with_normals<float>(2500, 65) : random_block<float>(2500, 2, 65);
+    const Block<float> y =
+        c == 6 ? points_with_normals<float>(2500, 66) : random_block<float>(2500, 2, 66);
+    std::vector<int> xy, yx, xy_tree, yx_tree;
+    NearestScratch<float> sx, sy;
+    nearest_both_ways<float>(x, y, xy, nullptr, yx, nullptr, &sx, &sy);
+    NearestIndex<float>(y).query(x, xy_tree);
+    NearestIndex<float>(x).query(y, yx_tree);
+    REQUIRE(xy == xy_tree);
+    REQUIRE(yx == yx_tree);
+    const double scan =
+        median_ms([&] { nearest_both_ways<float>(x, y, xy, nullptr, yx, nullptr, &sx, &sy); });
+    const double trees = median_ms([&] {
+      NearestIndex<float>(y).query(x, xy_tree);
+      NearestIndex<float>(x).query(y, yx_tree);
+    });
+    std::printf(
+        "both ways 2500 x 2500 in %dD, %d threads, median of 15: scan %.3f ms, two trees %.3f ms\n",
+        int(c), max_threads(), scan, trees);
+  }
 }

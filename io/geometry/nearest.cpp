@@ -213,6 +213,188 @@ void nearest_kdtree(const Block<T>& queries, const Block<T>& points, std::vector
   query_tree<T, Dim>(*build_tree<T, Dim>(source), queries, index, squared_distance, order, code);
 }
 
+// Every distance at once, for sets small enough (M N up to kPairsByScan): the
+// M x N squared distances, a row at a time, each row a loop over the points
+// in columns (points transposed, so the loop runs over contiguous floats and
+// vectorises), with the row's minimum and, for both_ways, every column's
+// running minimum kept as it goes. At the default M = 2500 in 6 columns this
+// is 6.25 M distances, cheaper than building a tree and searching it (the
+// tree's cells in 6D hold few points and overlap many query balls;
+// docs/performance.md, "Small searches by a scan"). Each distance is summed in
+// column order, the way squared_l2 sums it, and ties go to the lowest index,
+// so the answers are the tree's to the bit. Rows are split over the threads in
+// contiguous ranges; each thread keeps its own column minima, merged in thread
+// order (strict <: the lowest row wins ties), so the result does not depend on
+// the thread count.
+constexpr double kPairsByScan = double(1 << 24);
+
+template <class T>
+struct ScanScratch {
+  std::vector<T> transposed, column_best;
+  std::vector<int> column_index;
+};
+
+// One vector of lanes (GCC's and Clang's vector extension: 64 bytes, compiled
+// to whatever the target has, two AVX2 registers or one AVX-512), and the
+// same count of indices as integers of T's width, so a comparison's mask
+// selects both.
+template <class T>
+struct ScanLanes;
+template <>
+struct ScanLanes<float> {
+  typedef float Value __attribute__((vector_size(64)));
+  typedef int32_t Index __attribute__((vector_size(64)));
+  typedef int32_t Int;
+};
+template <>
+struct ScanLanes<double> {
+  typedef double Value __attribute__((vector_size(64)));
+  typedef int64_t Index __attribute__((vector_size(64)));
+  typedef int64_t Int;
+};
+
+// Rows [begin, end) of x against all of y (transposed into `cols` rows of
+// `padded` values, the padding at +infinity: never a minimum). R rows at a
+// time: each vector of y's lanes is loaded once for R rows, as a GEMM kernel
+// reuses a panel. Per row, each lane keeps its first minimum (strict <, j
+// ascending); per column, the block's R rows are merged in ascending order
+// first, then against the running minimum (strict <: earlier rows win ties).
+template <class T, int Dim, int R>
+void scan_rows(const T* x, Index cols_runtime, const T* yt, Index padded, Index begin, Index end,
+               std::vector<int>* x_to_y, std::vector<T>* x_distance, T* column_best,
+               int* column_index) {
+  using V = typename ScanLanes<T>::Value;
+  using I = typename ScanLanes<T>::Index;
+  using Int = typename ScanLanes<T>::Int;
+  constexpr int L = int(sizeof(V) / sizeof(T));
+  const Index cols = Dim > 0 ? Index(Dim) : cols_runtime;
+  I iota;
+  for (int l = 0; l < L; ++l) iota[l] = Int(l);
+  for (Index i0 = begin; i0 + R <= end; i0 += R) {
+    V row_best[R];
+    I row_at[R];
+    for (int r = 0; r < R; ++r) {
+      row_best[r] = V{} + std::numeric_limits<T>::infinity();
+      row_at[r] = I{} + Int(std::numeric_limits<int>::max());
+    }
+    for (Index j = 0; j < padded; j += L) {
+      V d[R];
+      for (int r = 0; r < R; ++r) d[r] = V{};
+      for (Index c = 0; c < cols; ++c) {
+        V yc;
+        __builtin_memcpy(&yc, yt + size_t(c * padded + j), sizeof(V));
+        for (int r = 0; r < R; ++r) {
+          const V diff = x[size_t((i0 + r) * cols + c)] - yc;
+          d[r] += diff * diff;
+        }
+      }
+      const I at = iota + Int(j);
+      for (int r = 0; r < R; ++r) {
+        const I closer = d[r] < row_best[r];
+        row_best[r] = closer ? d[r] : row_best[r];
+        row_at[r] = closer ? at : row_at[r];
+      }
+      if (column_best) {
+        V best = d[0];
+        I who = I{} + Int(i0);
+        for (int r = 1; r < R; ++r) {
+          const I closer = d[r] < best;
+          best = closer ? d[r] : best;
+          who = closer ? I{} + Int(i0 + r) : who;
+        }
+        V kept;
+        __builtin_memcpy(&kept, column_best + j, sizeof(V));
+        I kept_who;
+        for (int l = 0; l < L; ++l) kept_who[l] = Int(column_index[j + l]);
+        const I closer = best < kept;
+        kept = closer ? best : kept;
+        kept_who = closer ? who : kept_who;
+        __builtin_memcpy(column_best + j, &kept, sizeof(V));
+        for (int l = 0; l < L; ++l) column_index[j + l] = int(kept_who[l]);
+      }
+    }
+    if (!x_to_y) continue;
+    for (int r = 0; r < R; ++r) {  // the lanes merged: least distance, then lowest index
+      T best = row_best[r][0];
+      Int at = row_at[r][0];
+      for (int l = 1; l < L; ++l)
+        if (row_best[r][l] < best || (row_best[r][l] == best && row_at[r][l] < at)) {
+          best = row_best[r][l];
+          at = row_at[r][l];
+        }
+      // (Every distance infinite, the coordinates' squares overflowing: the first.)
+      (*x_to_y)[size_t(i0 + r)] = at == Int(std::numeric_limits<int>::max()) ? 0 : int(at);
+      if (x_distance) (*x_distance)[size_t(i0 + r)] = best;
+    }
+  }
+}
+
+template <class T, int Dim>
+void scan_nearest(const Block<T>& x, const Block<T>& y, std::vector<int>* x_to_y,
+                  std::vector<T>* x_distance, std::vector<int>* y_to_x, std::vector<T>* y_distance,
+                  ScanScratch<T>& s) {
+  constexpr int L = int(sizeof(typename ScanLanes<T>::Value) / sizeof(T));
+  constexpr int R = 4;  // rows per pass over y
+  const Index m = x.rows(), n = y.rows(), cols = x.cols();
+  const Index padded = (n + L - 1) / L * L;
+  s.transposed.assign(size_t(cols * padded), std::numeric_limits<T>::infinity());
+  for (Index j = 0; j < n; ++j)
+    for (Index c = 0; c < cols; ++c) s.transposed[size_t(c * padded + j)] = y(j, c);
+  const bool parallel = double(m) * double(n) > 1e5 && !region_would_be_serial();
+  const int threads = parallel ? max_threads() : 1;
+  if (y_to_x) {
+    s.column_best.assign(size_t(threads) * size_t(padded), std::numeric_limits<T>::infinity());
+    s.column_index.assign(size_t(threads) * size_t(padded), 0);
+  }
+  auto rows = [&](int thread, Index begin, Index end) {
+    T* column_best = y_to_x ? s.column_best.data() + size_t(thread) * size_t(padded) : nullptr;
+    int* column_index = y_to_x ? s.column_index.data() + size_t(thread) * size_t(padded) : nullptr;
+    const Index blocked = begin + (end - begin) / R * R;
+    scan_rows<T, Dim, R>(x.data(), cols, s.transposed.data(), padded, begin, blocked, x_to_y,
+                         x_distance, column_best, column_index);
+    scan_rows<T, Dim, 1>(x.data(), cols, s.transposed.data(), padded, blocked, end, x_to_y,
+                         x_distance, column_best, column_index);
+  };
+  if (threads == 1) {
+    rows(0, 0, m);
+  } else {
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (int t = 0; t < threads; ++t) rows(t, m * t / threads, m * (t + 1) / threads);
+  }
+  if (!y_to_x) return;
+  for (Index j = 0; j < n; ++j) {
+    T best = s.column_best[size_t(j)];
+    int at = s.column_index[size_t(j)];
+    for (int t = 1; t < threads; ++t) {
+      const size_t k = size_t(t) * size_t(padded) + size_t(j);
+      if (s.column_best[k] < best) {
+        best = s.column_best[k];
+        at = s.column_index[k];
+      }
+    }
+    (*y_to_x)[size_t(j)] = at;
+    if (y_distance) (*y_distance)[size_t(j)] = best;
+  }
+}
+
+template <class T>
+void scan_nearest(const Block<T>& x, const Block<T>& y, std::vector<int>* x_to_y,
+                  std::vector<T>* x_distance, std::vector<int>* y_to_x, std::vector<T>* y_distance,
+                  ScanScratch<T>& s) {
+  switch (x.cols()) {
+    case 2:
+      return scan_nearest<T, 2>(x, y, x_to_y, x_distance, y_to_x, y_distance, s);
+    case 3:
+      return scan_nearest<T, 3>(x, y, x_to_y, x_distance, y_to_x, y_distance, s);
+    case 6:
+      return scan_nearest<T, 6>(x, y, x_to_y, x_distance, y_to_x, y_distance, s);
+    case 9:
+      return scan_nearest<T, 9>(x, y, x_to_y, x_distance, y_to_x, y_distance, s);
+    default:
+      return scan_nearest<T, -1>(x, y, x_to_y, x_distance, y_to_x, y_distance, s);
+  }
+}
+
 // `points_checked`: the points' finiteness was checked when their index was built
 // (a NearestIndex's pool is fixed, and scanning 10^5-10^6 floats on every query
 // cost 1.7-2.1% of a training step, docs/performance.md).
@@ -236,6 +418,7 @@ struct NearestScratch<T>::Impl {
   TreeCache<T, 6> d6;
   TreeCache<T, 9> d9;
   TreeCache<T, -1> any;
+  ScanScratch<T> scan;
 };
 
 template <class T>
@@ -254,6 +437,12 @@ void nearest(const Block<T>& queries, const Block<T>& points, std::vector<int>& 
   index.resize(queries.rows());
   if (squared_distance) squared_distance->resize(queries.rows());
   typename NearestScratch<T>::Impl* s = scratch ? &scratch->impl() : nullptr;
+  if (double(queries.rows()) * double(points.rows()) <= kPairsByScan) {
+    ScanScratch<T> local;
+    scan_nearest<T>(queries, points, &index, squared_distance, nullptr, nullptr,
+                    s ? s->scan : local);
+    return;
+  }
   switch (points.cols()) {
     case 2:
       return nearest_kdtree<T, 2>(queries, points, index, squared_distance, s ? &s->d2 : nullptr);
@@ -346,6 +535,27 @@ const Block<T>& NearestIndex<T>::points() const {
 }
 
 template <class T>
+void nearest_both_ways(const Block<T>& x, const Block<T>& y, std::vector<int>& x_to_y,
+                       std::vector<T>* x_distance, std::vector<int>& y_to_x,
+                       std::vector<T>* y_distance, NearestScratch<T>* x_scratch,
+                       NearestScratch<T>* y_scratch) {
+  if (double(x.rows()) * double(y.rows()) > kPairsByScan) {
+    nearest(x, y, x_to_y, x_distance, x_scratch);
+    nearest(y, x, y_to_x, y_distance, y_scratch);
+    return;
+  }
+  check_shapes(x, y);
+  check_shapes(y, x);
+  x_to_y.resize(x.rows());
+  y_to_x.resize(y.rows());
+  if (x_distance) x_distance->resize(x.rows());
+  if (y_distance) y_distance->resize(y.rows());
+  ScanScratch<T> local;
+  scan_nearest(x, y, &x_to_y, x_distance, &y_to_x, y_distance,
+               x_scratch ? x_scratch->impl().scan : local);
+}
+
+template <class T>
 void nearest_brute_force(const Block<T>& queries, const Block<T>& points, std::vector<int>& index,
                          std::vector<T>* squared_distance) {
   check_shapes(queries, points);
@@ -376,6 +586,9 @@ void nearest_brute_force(const Block<T>& queries, const Block<T>& points, std::v
                            NearestScratch<T>*);                                                  \
   template void nearest_brute_force<T>(const Block<T>&, const Block<T>&, std::vector<int>&,      \
                                        std::vector<T>*);                                         \
+  template void nearest_both_ways<T>(const Block<T>&, const Block<T>&, std::vector<int>&,        \
+                                     std::vector<T>*, std::vector<int>&, std::vector<T>*,        \
+                                     NearestScratch<T>*, NearestScratch<T>*);                    \
   template class NearestIndex<T>;
 JSA_INSTANTIATE(float)
 JSA_INSTANTIATE(double)

@@ -1,7 +1,8 @@
 // Exact nearest neighbours: for every query row, the index of the closest row of
 // `points` (squared Euclidean distance, any number of columns). The Chamfer terms
-// (Eqs. 6-8) and the evaluation metrics stand on this. A kd-tree (nanoflann)
-// does the work; it stays inside nearest.cpp so nothing else sees its templates.
+// (Eqs. 6-8) and the evaluation metrics stand on this. Small sets (M N up to
+// 2^24) are scanned, every distance computed; larger ones go to a kd-tree
+// (nanoflann), which stays inside nearest.cpp so nothing else sees its templates.
 //
 // Ties: among points at exactly the same distance the lowest index wins, in both
 // the kd-tree and the brute-force oracle, so the two return the same indices.
@@ -45,6 +46,16 @@ class NearestScratch {
  private:
   std::unique_ptr<Impl> impl_;
 };
+
+// Both halves of a Chamfer distance at once: x_to_y as nearest(x, y), y_to_x as
+// nearest(y, x), the same answers. Small sets (M N up to 2^24) take one pass
+// over their M x N distances for both; larger ones two tree searches, with
+// x_scratch and y_scratch as nearest()'s.
+template <class T>
+void nearest_both_ways(const Block<T>& x, const Block<T>& y, std::vector<int>& x_to_y,
+                       std::vector<T>* x_distance, std::vector<int>& y_to_x,
+                       std::vector<T>* y_distance, NearestScratch<T>* x_scratch = nullptr,
+                       NearestScratch<T>* y_scratch = nullptr);
 
 // The oracle: the obvious O(M N) double loop, same contract as nearest().
 template <class T>
