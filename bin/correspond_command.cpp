@@ -101,6 +101,9 @@ void add_spectral_flags(CLI::App* c, bool& on, SpectralRefinementOptions& o) {
   c->add_flag("!--spectral-one-way", o.both_directions,
               "--spectral: refine the direction I -> J only (by default both directions are "
               "refined and, per point, the image nearer the atlas's own is taken)");
+  c->add_flag("--spectral-consensus", o.consensus,
+              "--spectral, 3 or more shapes: per point, the medoid of every map's estimate "
+              "(the atlas's, both directions', and through each other shape)");
 }
 
 void run_correspond(const CorrespondArgs& a) {
@@ -221,7 +224,9 @@ void run_eval_corr(const EvalCorrArgs& a) {
                                            : "q = phi_J(psi_I(p))";
   if (a.spectral)
     rule += std::string(", refined by ZoomOut") +
-            (a.spectral_options.both_directions ? " (both directions)" : "");
+            (a.spectral_options.consensus         ? " (consensus of the collection)"
+             : a.spectral_options.both_directions ? " (both directions)"
+                                                  : "");
   std::printf("correspondence error over %lld ordered pairs x %lld keypoints (%s)\n",
               (long long)e.pairs, (long long)e.keypoints, rule.c_str());
   std::printf("  mean L2 in the target's unit frame: %.3f x 1e-2\n", 100 * e.mean);
@@ -238,7 +243,8 @@ void run_eval_corr(const EvalCorrArgs& a) {
     const SpectralRefinementOptions& so = a.spectral_options;
     j["spectral"] = {{"functions", so.functions},     {"k_start", so.k_start},
                      {"k_step", so.k_step},           {"prior", so.prior_weight},
-                     {"prior_until", so.prior_until}, {"both_directions", so.both_directions}};
+                     {"prior_until", so.prior_until}, {"both_directions", so.both_directions},
+                     {"consensus", so.consensus}};
   }
   j["mean_l2_unit_frame"] = e.mean;
   j["mean_l2_x1e-2"] = 100 * e.mean;

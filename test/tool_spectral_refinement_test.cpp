@@ -77,3 +77,44 @@ TEST_CASE("the spectral refinement refuses a point cloud", "[tool][spectral_refi
   };
   CHECK_THROWS_AS(jsa::spectral_refinement(base, meshes, identity_frames(2)), jsa::InputError);
 }
+
+TEST_CASE("the collection's consensus outvotes one pair's mirrored map",
+          "[tool][spectral_refinement]") {
+  // Four copies of a strip symmetric under x -> 2 - x. The base map is the
+  // identity for every pair but 0 -> 1, which it mirrors; the prior keeps
+  // ZoomOut on the base's side of the symmetry, so T_01 stays the mirror.
+  const std::vector<jsa::Mesh> meshes(4, test_geometry::strip(40, 20, false, 0));
+  const Block<double>& flat = meshes[0].vertices;
+  const jsa::CorrespondenceMap base = [&](int from, int to, const Block<double>& p,
+                                          const Block<double>&) {
+    Block<double> q = p;
+    if (from == 0 && to == 1) q.col(0) = 2.0 - q.col(0).array();
+    return q;
+  };
+  const Block<double> normals = Block<double>::Zero(flat.rows(), 3);
+  auto mean_error = [&](const Block<double>& q) {  // against the identity
+    return (q - flat).rowwise().norm().mean();
+  };
+  REQUIRE(mean_error(base(0, 1, flat, normals)) > 0.4);
+  jsa::SpectralRefinementOptions o;
+  o.functions = 30;
+  o.k_start = 4;
+  o.k_step = 2;
+  o.samples = 400;
+  o.prior_until = 31;  // the prior on every size: ZoomOut follows the base's side
+  // Both directions, the atlas as referee: the inverse of T_10 is the identity,
+  // but the atlas's own image is the mirror, so the mirror stays.
+  const double referee = mean_error(
+      jsa::spectral_refinement(base, meshes, identity_frames(4), o)(0, 1, flat, normals));
+  o.consensus = true;
+  const jsa::CorrespondenceMap voted =
+      jsa::spectral_refinement(base, meshes, identity_frames(4), o);
+  // The consensus: the atlas and T_01 say mirror; the inverse of T_10 and the
+  // maps through shapes 2 and 3 say identity.
+  const double consensus = mean_error(voted(0, 1, flat, normals));
+  INFO("referee " << referee << ", consensus " << consensus);
+  CHECK(referee > 0.4);
+  CHECK(consensus < 0.05);
+  // A pair no map got wrong stays right.
+  CHECK(mean_error(voted(2, 3, flat, normals)) < 0.05);
+}

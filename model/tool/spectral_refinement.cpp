@@ -1,5 +1,6 @@
 #include "model/tool/spectral_refinement.h"
 
+#include <limits>
 #include <map>
 #include <memory>
 
@@ -82,26 +83,55 @@ CorrespondenceMap spectral_refinement(CorrespondenceMap base, const std::vector<
   r->meshes = meshes;
   r->functions = o.functions;
   const bool both = o.both_directions;
-  return [r, both](int from, int to, const Block<double>& p, const Block<double>& n) {
-    const std::vector<int>& map = r->vertex_map(from, to);
+  const bool consensus = o.consensus && meshes.size() >= 3;
+  return [r, both, consensus](int from, int to, const Block<double>& p, const Block<double>& n) {
+    const Block<double>& unit_j = r->shapes[size_t(to)].unit;
     std::vector<int> at;
     nearest(p, r->shapes[size_t(from)].unit, at);
-    Block<double> q(p.rows(), 3);
-    for (Index m = 0; m < p.rows(); ++m)
-      q.row(m) = r->shapes[size_t(to)].unit.row(map[size_t(at[size_t(m)])]);
-    if (both) {
-      // The other direction's map, inverted by nearest images: T_JI(y) for
-      // every vertex y of J, searched for the points p.
-      const std::vector<int>& back = r->vertex_map(to, from);
-      const Block<double>& unit_i = r->shapes[size_t(from)].unit;
-      Block<double> images(Index(back.size()), 3);
-      for (size_t y = 0; y < back.size(); ++y) images.row(Index(y)) = unit_i.row(back[y]);
-      std::vector<int> inverse;
-      nearest(p, images, inverse);
-      const Block<double> own = r->base(from, to, p, n);
+    // T_IJ(x) through the vertex map, for x at the vertices `at` of I.
+    auto carried = [&](const std::vector<int>& map) {
+      Block<double> q(p.rows(), 3);
+      for (Index m = 0; m < p.rows(); ++m) q.row(m) = unit_j.row(map[size_t(at[size_t(m)])]);
+      return q;
+    };
+    Block<double> q = carried(r->vertex_map(from, to));
+    if (!both && !consensus) return q;
+    // The other direction's map, inverted by nearest images: the vertex y of
+    // J whose T_JI(y) is nearest p.
+    const std::vector<int>& back = r->vertex_map(to, from);
+    const Block<double>& unit_i = r->shapes[size_t(from)].unit;
+    Block<double> images(Index(back.size()), 3);
+    for (size_t y = 0; y < back.size(); ++y) images.row(Index(y)) = unit_i.row(back[y]);
+    std::vector<int> inverse;
+    nearest(p, images, inverse);
+    const Block<double> own = r->base(from, to, p, n);
+    if (!consensus) {
       for (Index m = 0; m < p.rows(); ++m) {
-        const auto other = r->shapes[size_t(to)].unit.row(inverse[size_t(m)]);
+        const auto other = unit_j.row(inverse[size_t(m)]);
         if ((other - own.row(m)).norm() < (q.row(m) - own.row(m)).norm()) q.row(m) = other;
+      }
+      return q;
+    }
+    std::vector<Block<double>> estimates{own, q, Block<double>(p.rows(), 3)};
+    for (Index m = 0; m < p.rows(); ++m) estimates[2].row(m) = unit_j.row(inverse[size_t(m)]);
+    for (int k = 0; k < int(r->shapes.size()); ++k) {
+      if (k == from || k == to) continue;
+      const std::vector<int>& ik = r->vertex_map(from, k);
+      const std::vector<int>& kj = r->vertex_map(k, to);
+      Block<double> through(p.rows(), 3);
+      for (Index m = 0; m < p.rows(); ++m)
+        through.row(m) = unit_j.row(kj[size_t(ik[size_t(at[size_t(m)])])]);
+      estimates.push_back(std::move(through));
+    }
+    for (Index m = 0; m < p.rows(); ++m) {
+      double best = std::numeric_limits<double>::infinity();
+      for (const Block<double>& e : estimates) {
+        double sum = 0;  // the estimate's summed distance to the others
+        for (const Block<double>& f : estimates) sum += (e.row(m) - f.row(m)).norm();
+        if (sum < best) {
+          best = sum;
+          q.row(m) = e.row(m);
+        }
       }
     }
     return q;

@@ -36,6 +36,12 @@ struct SpectralRefinementOptions {
   // swapped with its symmetric twin (an ant's leg) is rarely swapped in both:
   // the atlas, right about which side is which, referees.
   bool both_directions = true;
+  // The collection as referee (N >= 3): the image of x is the medoid (least
+  // summed distance on J to the others) of every estimate the maps give: the
+  // atlas's own, T_IJ(x), the inverse of T_JI, and T_KJ(T_IK(x)) through every
+  // other shape K. An error one map makes on its own is outvoted by the maps
+  // that go around it. Overrides both_directions' rule.
+  bool consensus = false;
 };
 
 // `base` refined: for each ordered pair (I, J) met, every vertex of I is
