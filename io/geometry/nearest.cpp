@@ -544,8 +544,8 @@ void nearest_both_ways(const Block<T>& x, const Block<T>& y, std::vector<int>& x
     nearest(y, x, y_to_x, y_distance, y_scratch);
     return;
   }
-  check_shapes(x, y);
-  check_shapes(y, x);
+  check_shapes(x, y);  // both sets finite, y not empty, the same columns
+  JSA_CHECK(x.rows() >= 1, "nearest: no points to search");
   x_to_y.resize(x.rows());
   y_to_x.resize(y.rows());
   if (x_distance) x_distance->resize(x.rows());
