@@ -78,6 +78,19 @@ TEST_CASE("the spectral refinement refuses a point cloud", "[tool][spectral_refi
   CHECK_THROWS_AS(jsa::spectral_refinement(base, meshes, identity_frames(2)), jsa::InputError);
 }
 
+TEST_CASE("the consensus refuses fewer than three shapes", "[tool][spectral_refinement]") {
+  const std::vector<jsa::Mesh> meshes(2, test_geometry::strip(4, 2, false, 0));
+  const jsa::CorrespondenceMap base = [](int, int, const Block<double>& p, const Block<double>&) {
+    return p;
+  };
+  jsa::SpectralRefinementOptions o;
+  o.functions = 4;
+  o.consensus = true;
+  CHECK_THROWS_AS(jsa::spectral_refinement(base, meshes, identity_frames(2), o), jsa::InputError);
+  o.consensus = false;
+  CHECK_NOTHROW(jsa::spectral_refinement(base, meshes, identity_frames(2), o));
+}
+
 TEST_CASE("the collection's consensus outvotes one pair's mirrored map",
           "[tool][spectral_refinement]") {
   // Four copies of a strip symmetric under x -> 2 - x. The base map is the

@@ -57,6 +57,9 @@ CorrespondenceMap spectral_refinement(CorrespondenceMap base, const std::vector<
                                       const std::vector<Normalization>& frames,
                                       const SpectralRefinementOptions& o) {
   JSA_CHECK(frames.size() == meshes.size(), "spectral_refinement: one frame per mesh");
+  if (o.consensus && meshes.size() < 3)
+    throw InputError("the spectral consensus needs three or more shapes (--spectral-consensus; " +
+                     std::to_string(meshes.size()) + " given)");
   auto r = std::make_shared<Refinement>();
   r->base = std::move(base);
   r->zoomout.k_start = o.k_start;
@@ -83,7 +86,7 @@ CorrespondenceMap spectral_refinement(CorrespondenceMap base, const std::vector<
   r->meshes = meshes;
   r->functions = o.functions;
   const bool both = o.both_directions;
-  const bool consensus = o.consensus && meshes.size() >= 3;
+  const bool consensus = o.consensus;
   return [r, both, consensus](int from, int to, const Block<double>& p, const Block<double>& n) {
     const Block<double>& unit_j = r->shapes[size_t(to)].unit;
     std::vector<int> at;

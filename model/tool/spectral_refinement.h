@@ -40,7 +40,8 @@ struct SpectralRefinementOptions {
   // summed distance on J to the others) of every estimate the maps give: the
   // atlas's own, T_IJ(x), the inverse of T_JI, and T_KJ(T_IK(x)) through every
   // other shape K. An error one map makes on its own is outvoted by the maps
-  // that go around it. Overrides both_directions' rule.
+  // that go around it. Overrides both_directions' rule; fewer than three
+  // shapes are refused (InputError).
   bool consensus = false;
 };
 
