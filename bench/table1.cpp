@@ -51,12 +51,20 @@ constexpr double kUnits = 100;  // x 1e-2
 // Row 12 is not the paper's: jsatlas's own recipe for a collection (recipe_options).
 constexpr int kRecipeRow = 12;
 
+// `jsatlas fit`'s defaults for a collection where the bench has no option of
+// its own: the learning rate (FitOptions::lr is a single shape's).
+inline FitOptions collection_defaults() {
+  FitOptions o;
+  o.lr = kCollectionLearningRate;
+  return o;
+}
+
 struct Args {
   std::string out, category, keypoint_dir;
   std::vector<std::string> inputs;
   std::vector<int> rows = {1, 2, 3, 4, 6, 7, 8, 9, 10, 11, kRecipeRow};
   int seeds = 4, threads = 0;
-  FitOptions fit;  // the CLI defaults of `jsatlas fit`
+  FitOptions fit = collection_defaults();  // the CLI defaults of `jsatlas fit` for collections
   Index samples = 2000;
   std::string command;
 };
@@ -126,6 +134,7 @@ FitOptions recipe_options(const FitOptions& table, const std::vector<Block<doubl
   o.seed = table.seed;
   o.threads = table.threads;
   o.schedule.kind = "step";  // collections keep M fixed (bin/fit_command.cpp)
+  o.weights.evenness = 0;    // and L_even off
   o.atlas.deform_layers = kCollectionDeformLayers;
   o.template_steps = -1;
   o.template_share = 0.3;

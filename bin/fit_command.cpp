@@ -61,6 +61,7 @@ struct FitArgs {
   // have defaults of their own (kFixedScheduleIterations in model/tool/trainer.h).
   bool iters_given = false, schedule_given = false;
   bool even_given = false;  // --w-even
+  bool lr_given = false;    // --lr
   bool points_given = false, gaussians_given = false, width_given = false, deform_given = false;
 };
 
@@ -243,6 +244,8 @@ void run_fit(FitArgs& a, Team& team) {
     const bool fixed_m = inputs.size() > 1 || !a.preset.empty();
     if (fixed_m && !a.schedule_given) o.schedule.kind = "step";
     if (fixed_m && !a.iters_given) o.iterations = kFixedScheduleIterations;
+    // So does their learning rate (FitOptions::lr: a single shape's was measured).
+    if (fixed_m && !a.lr_given) o.lr = kCollectionLearningRate;
     // L_even was measured on single shapes (docs/results.md); a collection
     // keeps the objective its rounds were measured with unless told.
     if (inputs.size() > 1 && !a.even_given) o.weights.evenness = 0;
@@ -915,7 +918,7 @@ void add_fit(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber)
       ->check(kFinite);
-  c->add_option("--lr", o.lr, "Adam learning rate")
+  c->add_option("--lr", o.lr, "Adam learning rate (collections and --preset paper: 1e-3)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber)
       ->check(kFinite);
@@ -1172,6 +1175,7 @@ void add_fit(CLI::App& app) {
     a->width_given = c->count("--width") > 0;
     a->deform_given = c->count("--deform-layers") > 0;
     a->even_given = c->count("--w-even") > 0;
+    a->lr_given = c->count("--lr") > 0;
     std::unique_ptr<Team> team = join_team();
     if (team->size() == 1) return run_fit(*a, *team);
     try {

@@ -85,6 +85,10 @@ void build_grid(const Block<T>& mu, double r_c, Grid& g, std::vector<T>& xs, std
   g.nx = Index(wx / g.h) + 1;
   g.ny = Index(wy / g.h) + 1;
   g.cell_of.resize(K);
+  // nx ny <= max_cells by the loop above: kept at that size from the first
+  // step, the grid does not allocate again when the means spread.
+  g.start.reserve(size_t(max_cells) + 1);
+  fill.reserve(size_t(max_cells));
   g.start.assign(g.nx * g.ny + 1, 0);
   for (Index i = 0; i < K; ++i) {
     g.cell_of[i] = g.cell_y(double(mu(i, 1))) * g.nx + g.cell_x(double(mu(i, 0)));

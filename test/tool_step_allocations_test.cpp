@@ -48,7 +48,7 @@ std::vector<long> step_allocations(Trainer& t, int warmup, int count) {
 
 }  // namespace
 
-TEST_CASE("trainer: steps 3 to 5 of a fit allocate nothing", "[trainer]") {
+TEST_CASE("trainer: steps 3 to 10 of a fit allocate nothing", "[trainer]") {
   if (!allocation_counter::counting_available()) {
     WARN("no allocation counting under a sanitizer");
     return;
@@ -60,7 +60,7 @@ TEST_CASE("trainer: steps 3 to 5 of a fit allocate nothing", "[trainer]") {
       ~Threads() { set_threads(before); }
     } scope(threads);
     Trainer t(small_options(), sphere_pool(4000, 1));
-    for (long n : step_allocations(t, 3, 3)) {
+    for (long n : step_allocations(t, 3, 8)) {
       INFO(threads << " threads");
       CHECK(n == 0);
     }
@@ -80,7 +80,7 @@ TEST_CASE("trainer: ... and a collection's step, its shapes split over threads",
   FitOptions o = small_options();
   o.atlas.deform_layers = 2;  // phi_i(x) = phi(x) + D(phi(x), f_i), as collections fit
   Trainer t(o, std::vector<Block<double>>{sphere_pool(4000, 1), sphere_pool(4000, 2)});
-  for (long n : step_allocations(t, 3, 3)) {
+  for (long n : step_allocations(t, 3, 8)) {
     CHECK(t.shape_threads() == 2);
     CHECK(n == 0);
   }
