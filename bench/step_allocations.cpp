@@ -132,6 +132,8 @@ int main(int argc, char** argv) {
       o.atlas.deform_layers = kCollectionDeformLayers;
       o.schedule.kind = "step";
       o.iterations = kFixedScheduleIterations;
+      o.lr = kCollectionLearningRate;
+      o.weights.evenness = 0;
     }
     o.threads = threads;
     if (points > 0) o.points = points;

@@ -92,6 +92,7 @@ json budget_json(const Args& a) {
   b["depth"] = a.fit.atlas.hidden_layers;
   b["code_size"] = a.fit.atlas.code_size;
   b["lr"] = a.fit.lr;
+  b["recipe_w_even"] = 0.0;  // row 12 as `jsatlas fit` collections (L_even on before 2026-12-05)
   b["pool"] = a.fit.pool;
   b["eval_samples"] = a.samples;
   b["inputs"] = a.inputs;

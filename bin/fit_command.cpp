@@ -231,6 +231,7 @@ void run_fit(FitArgs& a, Team& team) {
       if (a.preset != "paper")
         throw InputError("--preset: unknown preset '" + a.preset + "' (known: paper)");
       apply_paper_preset(o);
+      if (a.lr_given) o.lr = a.options.lr;  // the preset sets 1e-3 unless told
     }
     if (a.table_row) o.components = Components::table_row(a.table_row);
     if (a.no_normals) o.components.normals = false;

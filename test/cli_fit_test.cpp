@@ -12,6 +12,7 @@
 
 #include "io/geometry/builtin_shapes.h"
 #include "io/pictures/image.h"
+#include "model/tool/trainer.h"
 #include "test/cli_test_support.h"
 
 using namespace cli_test;
@@ -317,12 +318,17 @@ TEST_CASE("cli: the schedule's flags are saved, collections keep M fixed, a shor
   CHECK(settings(dir + "_pair")["schedule"]["kind"] == "step");
   CHECK(settings(dir + "_pair")["iterations"] == 5000);
   CHECK(settings(dir + "_pair")["weights"]["evenness"] == 0);  // L_even: single shapes only
+  CHECK(settings(dir + "_pair")["lr"] == jsa::kCollectionLearningRate);  // 1e-3
   r = run("fit builtin:sphere builtin:torus -o " + dir +
           "_pair_ramp --stop-at 1 --template-steps 0 --no-align --schedule ramp --iters 30" +
           kSmall);
   REQUIRE(r.code == 0);
   CHECK(settings(dir + "_pair_ramp")["schedule"]["kind"] == "ramp");
   CHECK(settings(dir + "_pair_ramp")["iterations"] == 30);
+  r = run("fit builtin:sphere builtin:torus -o " + dir +
+          "_pair_lr --stop-at 1 --template-steps 0 --no-align --lr 5e-3" + kSmall);
+  REQUIRE(r.code == 0);
+  CHECK(settings(dir + "_pair_lr")["lr"] == 5e-3);  // a given rate is kept
   CHECK(run("fit builtin:sphere -o " + dir + "_bad --schedule cosine" + kSmall).code == 2);
   CHECK(run("fit builtin:sphere -o " + dir + "_bad --points-start 0" + kSmall).code == 2);
   CHECK(run("fit builtin:sphere -o " + dir + "_bad --ramp-levels 0" + kSmall).code == 2);
@@ -336,6 +342,8 @@ TEST_CASE("cli: the schedule's flags are saved, collections keep M fixed, a shor
   CHECK(settings(dir + "_budget")["iterations"] > 25);
   CHECK(settings(dir + "_budget")["weights"]["evenness"] == 0.003);  // the single-shape default
   CHECK(settings(dir + "_budget")["evenness_from"] == 0.5);
+  CHECK(settings(dir + "_budget")["lr"] == jsa::FitOptions().lr);  // a single shape's, 2e-3
+  CHECK(jsa::FitOptions().lr == 2 * jsa::kCollectionLearningRate);
   // Under --minutes the template start takes its share of the time, but no
   // more than --template-max-steps; the joint training gets the rest. (1.8 s
   // of template time for 40 steps of these tiny networks: a wide margin.)

@@ -61,6 +61,9 @@ TEST_CASE(
   CHECK(o.reseed_every == 0);
   CHECK(o.iterations == 7);
   CHECK(o.seed == 9);
+  CHECK(jsa::FitOptions().lr == 2e-3);          // a single shape's default
+  CHECK(o.lr == jsa::kCollectionLearningRate);  // the preset's: 1e-3
+  CHECK(jsa::kCollectionLearningRate == 1e-3);
   CHECK(jsa::fit_options_to_json(jsa::paper_fit_options()).find("\"cycle\": 1.0") !=
         std::string::npos);
 }
