@@ -51,20 +51,12 @@ constexpr double kUnits = 100;  // x 1e-2
 // Row 12 is not the paper's: jsatlas's own recipe for a collection (recipe_options).
 constexpr int kRecipeRow = 12;
 
-// `jsatlas fit`'s defaults for a collection where the bench has no option of
-// its own: the learning rate (FitOptions::lr is a single shape's).
-inline FitOptions collection_defaults() {
-  FitOptions o;
-  o.lr = kCollectionLearningRate;
-  return o;
-}
-
 struct Args {
   std::string out, category, keypoint_dir;
   std::vector<std::string> inputs;
   std::vector<int> rows = {1, 2, 3, 4, 6, 7, 8, 9, 10, 11, kRecipeRow};
   int seeds = 4, threads = 0;
-  FitOptions fit = collection_defaults();  // the CLI defaults of `jsatlas fit` for collections
+  FitOptions fit;  // the CLI defaults of `jsatlas fit` (main: the paper's method, lr 1e-3)
   Index samples = 2000;
   std::string command;
 };
