@@ -116,7 +116,9 @@ auto with_flag_names(F&& f) {
       {"schedule.points_start", "--points-start"},
       {"schedule.ramp_until", "--ramp-until"},
       {"schedule.levels", "--ramp-levels"},
-      {"schedule.warmup", "--warmup"}};
+      {"schedule.warmup", "--warmup"},
+      {"schedule.drop_at", "--lr-drop-at"},
+      {"schedule.drop", "--lr-drop"}};
   try {
     return f();
   } catch (const InputError& e) {
@@ -953,6 +955,16 @@ void add_fit(CLI::App& app) {
                 "Fraction of the run over which lr rises linearly from lr/10 (0: none)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0))
+      ->check(kFinite);
+  c->add_option("--lr-drop-at", o.schedule.drop_at,
+                "Fraction of the run from which the learning rate is multiplied by --lr-drop "
+                "(0: never)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0))
+      ->check(kFinite);
+  c->add_option("--lr-drop", o.schedule.drop, "Learning-rate factor from --lr-drop-at on")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-6, 1.0))
       ->check(kFinite);
   c->add_option("--minutes", a->minutes,
                 "Time budget: after 5 warm-up and 20 timed iterations, set --iters to fill it (the "

@@ -7,7 +7,9 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <csignal>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <thread>
 
 #include "io/geometry/builtin_shapes.h"
@@ -294,7 +296,7 @@ TEST_CASE("cli: the schedule's flags are saved, collections keep M fixed, a shor
   const std::string dir = fresh_dir("schedule");
   Result r = run("fit builtin:sphere -o " + dir +
                  " --iters 8 --points-start 0.5 --ramp-until 0.5 --ramp-levels 2 --warmup 0.25"
-                 " --w-even 0.01 --w-even-from 0.25" +
+                 " --w-even 0.01 --w-even-from 0.25 --lr-drop-at 0.5 --lr-drop 0.25" +
                  kSmall.substr(0, kSmall.size() - 3));  // without -q: the first line says M
   INFO(r.output);
   REQUIRE(r.code == 0);
@@ -309,6 +311,23 @@ TEST_CASE("cli: the schedule's flags are saved, collections keep M fixed, a shor
   CHECK(single["schedule"]["ramp_until"] == 0.5);
   CHECK(single["schedule"]["levels"] == 2);
   CHECK(single["schedule"]["warmup"] == 0.25);
+  CHECK(single["schedule"]["drop_at"] == 0.5);
+  CHECK(single["schedule"]["drop"] == 0.25);
+  {
+    // The rate each step used (losses.csv's second column): 2e-3 after the
+    // warm-up (2 steps of 8), x 0.25 from step 4 on, before the decays (6, 7).
+    std::istringstream rows(read_text(dir + "/losses.csv"));
+    std::string row;
+    std::map<int, double> lr;
+    std::getline(rows, row);  // header
+    while (std::getline(rows, row)) {
+      const auto comma = row.find(',');
+      lr[std::stoi(row.substr(0, comma))] = std::stod(row.substr(comma + 1));
+    }
+    REQUIRE(lr.size() == 8);
+    CHECK(lr[3] == Approx(2e-3));
+    CHECK(lr[5] == Approx(5e-4));
+  }
   CHECK(single["weights"]["evenness"] == 0.01);  // L_even's weight and start
   CHECK(single["evenness_from"] == 0.25);
   // A collection without --schedule or --iters: M fixed for 5000 steps.

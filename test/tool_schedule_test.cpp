@@ -5,6 +5,7 @@
 // a fault's rewind and the template start of a collection.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstring>
 #include <set>
 #include <string>
 
@@ -71,6 +72,21 @@ TEST_CASE("schedule: the warm-up rises linearly from lr/10", "[schedule]") {
   CHECK(jsa::scheduled_lr(s, 1e-3, {0.75}, 0.1, 800, 1000) == Approx(1e-4));
 }
 
+TEST_CASE("schedule: the drop multiplies the rate from its fraction of the run on, decays too",
+          "[schedule]") {
+  ScheduleOptions s;
+  s.drop_at = 0.5;
+  s.drop = 0.5;
+  CHECK(jsa::scheduled_lr(s, 2e-3, {0.75}, 0.1, 0, 1000) == Approx(2e-3));
+  CHECK(jsa::scheduled_lr(s, 2e-3, {0.75}, 0.1, 499, 1000) == Approx(2e-3));
+  CHECK(jsa::scheduled_lr(s, 2e-3, {0.75}, 0.1, 500, 1000) == Approx(1e-3));
+  CHECK(jsa::scheduled_lr(s, 2e-3, {0.75}, 0.1, 749, 1000) == Approx(1e-3));
+  CHECK(jsa::scheduled_lr(s, 2e-3, {0.75}, 0.1, 750, 1000) == Approx(1e-4));
+  // drop_at = 0 is no drop, whatever the factor.
+  s.drop_at = 0;
+  CHECK(jsa::scheduled_lr(s, 2e-3, {0.75}, 0.1, 600, 1000) == Approx(2e-3));
+}
+
 TEST_CASE("schedule: a weight moves geometrically to its end value, then stays", "[schedule]") {
   // 1e-2 -> 1e-1 by iteration 750 of 1000: a decade in 750 steps.
   CHECK(jsa::scheduled_weight(1e-2, 1e-1, 0.75, 0, 1000) == Approx(1e-2));
@@ -92,6 +108,8 @@ TEST_CASE("schedule: stored in the run's settings, older runs read as step",
   o.schedule.ramp_until = 0.6;
   o.schedule.levels = 3;
   o.schedule.warmup = 0.05;
+  o.schedule.drop_at = 0.5;
+  o.schedule.drop = 0.25;
   const std::string text = jsa::fit_options_to_json(o, -1);
   const jsa::FitOptions back = jsa::fit_options_from_json(text, "x");
   CHECK(back.schedule.kind == "ramp");
@@ -99,6 +117,18 @@ TEST_CASE("schedule: stored in the run's settings, older runs read as step",
   CHECK(back.schedule.ramp_until == 0.6);
   CHECK(back.schedule.levels == 3);
   CHECK(back.schedule.warmup == 0.05);
+  CHECK(back.schedule.drop_at == 0.5);
+  CHECK(back.schedule.drop == 0.25);
+  // Runs written before the drop existed: no drop.
+  std::string before_drop = text;
+  for (const char* key : {"\"drop\":0.25,", "\"drop_at\":0.5,"}) {
+    const auto k = before_drop.find(key);
+    REQUIRE(k != std::string::npos);
+    before_drop.erase(k, std::strlen(key));
+  }
+  const jsa::FitOptions no_drop = jsa::fit_options_from_json(before_drop, "x");
+  CHECK(no_drop.schedule.drop_at == 0);
+  CHECK(no_drop.schedule.drop == 1);
   std::string old = text;
   const auto at = old.find(",\"schedule\":");
   REQUIRE(at != std::string::npos);

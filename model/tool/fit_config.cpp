@@ -76,7 +76,9 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
                    {"points_start", o.schedule.points_start},
                    {"ramp_until", o.schedule.ramp_until},
                    {"levels", o.schedule.levels},
-                   {"warmup", o.schedule.warmup}};
+                   {"warmup", o.schedule.warmup},
+                   {"drop_at", o.schedule.drop_at},
+                   {"drop", o.schedule.drop}};
   j["seed"] = o.seed;
   j["repulsion_tolerance"] = o.repulsion_tolerance;
   j["max_faults"] = o.max_faults;
@@ -184,11 +186,16 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
     field(s, "schedule.", "ramp_until", o.schedule.ramp_until);
     field(s, "schedule.", "levels", o.schedule.levels);
     field(s, "schedule.", "warmup", o.schedule.warmup);
+    // Runs written before the drop existed have neither field: no drop.
+    if (s.contains("drop_at")) field(s, "schedule.", "drop_at", o.schedule.drop_at);
+    if (s.contains("drop")) field(s, "schedule.", "drop", o.schedule.drop);
     if (o.schedule.kind != "ramp" && o.schedule.kind != "step")
       throw InputError(what + ": field 'schedule.kind' must be \"ramp\" or \"step\"");
     if (!(o.schedule.points_start > 0 && o.schedule.points_start <= 1) ||
         !(o.schedule.ramp_until > 0 && o.schedule.ramp_until <= 1) || o.schedule.levels < 1 ||
-        o.schedule.levels > 1000 || !(o.schedule.warmup >= 0 && o.schedule.warmup <= 1))
+        o.schedule.levels > 1000 || !(o.schedule.warmup >= 0 && o.schedule.warmup <= 1) ||
+        !(o.schedule.drop_at >= 0 && o.schedule.drop_at <= 1) ||
+        !(o.schedule.drop > 0 && o.schedule.drop <= 1))
       throw InputError(what + ": a field of 'schedule' is out of range");
   }
   field(j, "", "seed", o.seed);

@@ -28,6 +28,10 @@ struct ScheduleOptions {
   double ramp_until = 0.75;    // ramp: fraction of the run by which M is final (the first decay)
   int levels = 4;              // ramp: M grows in this many equal steps
   double warmup = 0;           // fraction of the run over which lr rises linearly from lr/10
+  // From this fraction of the run on, lr *= drop (0: never): the surface found
+  // at a high rate, its details and L_even's spreading at a lower one.
+  double drop_at = 0;
+  double drop = 1;
 };
 
 // The work of a step that does not grow with M, in points' worth (L_rep over
@@ -47,8 +51,8 @@ inline Index scheduled_points(const ScheduleOptions& s, Index points, int64_t i,
 }
 
 // The learning rate at iteration i of n: the step decays (lr *= decay at each
-// fraction of decay_at), times a linear warm-up from lr/10 over the first
-// warmup * n iterations.
+// fraction of decay_at) and the drop (lr *= drop from drop_at n on), times a
+// linear warm-up from lr/10 over the first warmup * n iterations.
 inline double scheduled_lr(const ScheduleOptions& s, double lr, const std::vector<double>& decay_at,
                            double decay, int64_t i, int64_t n) {
   // step_decay over the milestones round(f n), counted in place (the trainer
@@ -56,6 +60,7 @@ inline double scheduled_lr(const ScheduleOptions& s, double lr, const std::vecto
   double r = lr;
   for (double f : decay_at)
     if (i >= int64_t(std::llround(f * double(n)))) r *= decay;
+  if (s.drop_at > 0 && i >= int64_t(std::llround(s.drop_at * double(n)))) r *= s.drop;
   const double w = s.warmup * double(n);
   if (w >= 1 && double(i) < w) r *= 0.1 + 0.9 * double(i) / w;
   return r;

@@ -67,6 +67,8 @@ static void validate(const FitOptions& o) {
   require(s.ramp_until > 0 && s.ramp_until <= 1, "schedule.ramp_until must be in (0, 1]");
   require(s.levels >= 1 && s.levels <= 1000, "schedule.levels must be in [1, 1000]");
   require(s.warmup >= 0 && s.warmup <= 1, "schedule.warmup must be in [0, 1]");
+  require(s.drop_at >= 0 && s.drop_at <= 1, "schedule.drop_at must be in [0, 1]");
+  require(s.drop > 0 && s.drop <= 1, "schedule.drop must be in (0, 1]");
 }
 
 void Trainer::require_rank_support(const FitOptions& o, int shapes, int ranks) {
