@@ -60,6 +60,32 @@ TEST_CASE("cli: fit writes every output and the follow-up commands read them", "
   INFO(r.output);
   CHECK(r.code == 0);
   CHECK(r.output.find("Chamfer spatial") != std::string::npos);
+  // --draws: every metric the mean of the single draws seeded seed + d.
+  const auto eval_json = [&](const std::string& flags) {
+    const Result e = run("eval " + dir + " --samples 300 --threads 1 " + flags);
+    INFO(e.output);
+    REQUIRE(e.code == 0);
+    return nlohmann::json::parse(read_text(dir + "/eval.json"));
+  };
+  const nlohmann::json mean = eval_json("--seed 5 --draws 3");
+  CHECK(mean["draws"] == 3);
+  REQUIRE(mean["emd_ratio_per_draw"].size() == 3);
+  double emd = 0, floor_emd = 0, chamfer = 0, normal = 0;
+  for (int d = 0; d < 3; ++d) {
+    const nlohmann::json one = eval_json("--draws 1 --seed " + std::to_string(5 + d));
+    emd += one["emd_spatial"].get<double>() / 3;
+    floor_emd += one["floor_emd_spatial"].get<double>() / 3;
+    chamfer += one["chamfer_spatial"].get<double>() / 3;
+    normal += one["chamfer_normal_unit"].get<double>() / 3;
+    CHECK(mean["emd_ratio_per_draw"][size_t(d)].get<double>() ==
+          Approx(one["emd_spatial"].get<double>() / one["floor_emd_spatial"].get<double>())
+              .epsilon(1e-12));
+  }
+  CHECK(mean["emd_spatial"].get<double>() == Approx(emd).epsilon(1e-12));
+  CHECK(mean["floor_emd_spatial"].get<double>() == Approx(floor_emd).epsilon(1e-12));
+  CHECK(mean["chamfer_spatial"].get<double>() == Approx(chamfer).epsilon(1e-12));
+  CHECK(mean["chamfer_normal_unit"].get<double>() == Approx(normal).epsilon(1e-12));
+  CHECK(run("eval " + dir + " --draws 0").code != 0);
 }
 
 TEST_CASE("cli: a run stopped by SIGTERM and resumed gives the uninterrupted losses", "[cli]") {

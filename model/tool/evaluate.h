@@ -4,6 +4,8 @@
 // independent samples of the shape, which is the best a perfect fit can score.
 // Both under the Chamfer association and under the exact EMD assignment.
 #pragma once
+#include <vector>
+
 #include "io/geometry/mesh.h"
 #include "io/geometry/normalization.h"
 #include "losses/metrics/emd.h"
@@ -15,6 +17,12 @@ namespace jsa {
 struct EvaluationOptions {
   Index samples = 2000;  // M' (paper: 2000)
   uint64_t seed = 0;     // seeds both the P draws and the surface samples
+  // Independent draws of the M' points on every side (draw d seeded seed + d),
+  // every metric the mean over them. One draw is a noisy measurement where the
+  // shape is thin: on one fitted ant the EMD against its floor ranged over
+  // 0.99-1.92 between six draws of 2000 points (docs/results.md, "The EMD's
+  // own noise"); the mean of both sides over the draws is the ratio to read.
+  int draws = 1;
 };
 
 struct Evaluation {
@@ -22,6 +30,8 @@ struct Evaluation {
   SurfaceMetrics floor;  // shape vs an independent sample of itself
   EmdMetrics fit_emd;    // the same pairs of sets under the exact EMD assignment (Eq. 13)
   EmdMetrics floor_emd;
+  // Per draw, atlas over floor: how far one draw's ratio strays from the mean's.
+  std::vector<double> chamfer_ratio, emd_ratio;
 };
 
 // `index`: which shape of a collection (0 for a single shape).
