@@ -61,6 +61,7 @@ struct FitArgs {
   // have defaults of their own (kFixedScheduleIterations in model/tool/trainer.h).
   bool iters_given = false, schedule_given = false;
   bool even_given = false;  // --w-even
+  bool emd_given = false;   // --w-emd
   bool lr_given = false;    // --lr
   bool points_given = false, gaussians_given = false, width_given = false, deform_given = false;
 };
@@ -95,6 +96,7 @@ auto with_flag_names(F&& f) {
       {"weights.code", "--w-code"},
       {"weights.metric", "--w-metric"},
       {"weights.evenness", "--w-even"},
+      {"weights.transport", "--w-emd"},
       {"weights.coverage", "--w-coverage"},
       {"metric_end", "--w-metric-end"},
       {"repulsion_tolerance", "--repulsion-tolerance"},
@@ -106,6 +108,8 @@ auto with_flag_names(F&& f) {
       {"template_shape", "--template-shape"},
       {"chart_from", "--chart-from"},
       {"evenness_from", "--w-even-from"},
+      {"transport_from", "--w-emd-from"},
+      {"transport_points", "--emd-points"},
       {"code_lr_scale", "--code-lr-scale"},
       {"surface_lr_scale", "--surface-lr-scale"},
       {"intrinsic", "--intrinsic"},
@@ -252,6 +256,7 @@ void run_fit(FitArgs& a, Team& team) {
     // L_even was measured on single shapes (docs/results.md); a collection
     // keeps the objective its rounds were measured with unless told.
     if (inputs.size() > 1 && !a.even_given) o.weights.evenness = 0;
+    if (inputs.size() > 1 && !a.emd_given) o.weights.transport = 0;  // so does L_EMD
     if (inputs.size() > 1 && a.preset.empty()) {  // trainer.h: sized for a laptop's minutes
       if (!a.points_given) o.points = kCollectionPoints;
       if (!a.gaussians_given) o.atlas.gaussians = kCollectionGaussians;
@@ -883,6 +888,13 @@ void add_fit(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber)
       ->check(kFinite);
+  c->add_option("--w-emd", o.weights.transport,
+                "lambda_EMD on L_EMD, the exact assignment of --emd-points samples to as many "
+                "targets as a term: every target a sample of its own (beyond the paper; 0: off; "
+                "docs/results.md)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber)
+      ->check(kFinite);
   c->add_option("--w-metric-end", o.metric_end,
                 "Collections: lambda_metric moves geometrically from --w-metric at the first "
                 "joint step to this at the first learning-rate decay (-1: constant)")
@@ -1112,6 +1124,15 @@ void add_fit(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0))
       ->check(kFinite);
+  c->add_option("--w-emd-from", o.transport_from,
+                "L_EMD (--w-emd) from this fraction of --iters on (0: all along)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0))
+      ->check(kFinite);
+  c->add_option("--emd-points", o.transport_points,
+                "L_EMD's n: the first n of a step's samples and targets (at most M)")
+      ->capture_default_str()
+      ->check(CLI::Range(Index(1), Index(100000)));
   c->add_option("--chart-from", o.chart_from,
                 "Staged objective: phi and P alone (no psi, L_2D, L_cycle) until this fraction of "
                 "--iters, then the full method (0: full from the start)")
@@ -1188,6 +1209,7 @@ void add_fit(CLI::App& app) {
     a->width_given = c->count("--width") > 0;
     a->deform_given = c->count("--deform-layers") > 0;
     a->even_given = c->count("--w-even") > 0;
+    a->emd_given = c->count("--w-emd") > 0;
     a->lr_given = c->count("--lr") > 0;
     std::unique_ptr<Team> team = join_team();
     if (team->size() == 1) return run_fit(*a, *team);

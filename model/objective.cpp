@@ -9,6 +9,7 @@
 #include "losses/evenness.h"
 #include "losses/isometry.h"
 #include "losses/repulsion.h"
+#include "losses/transport.h"
 
 namespace jsa {
 
@@ -48,10 +49,10 @@ const Block<T>& reference_points(Tape<T>& t, Atlas<T>& atlas, Var x_p, int refer
 // The weighted terms of L_single (Eq. 5), at most one of each kind: a fixed
 // array, not a vector (nothing in a step may allocate).
 struct WeightedTerms {
-  std::pair<double, Var> term[10];
+  std::pair<double, Var> term[12];
   int count = 0;
   void push_back(std::pair<double, Var> t) {
-    JSA_CHECK(count < 10, "more loss terms than WeightedTerms holds");
+    JSA_CHECK(count < 12, "more loss terms than WeightedTerms holds");
     term[count++] = t;
   }
 };
@@ -144,6 +145,14 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
                                    first_m(all.du), first_m(all.dv));
     weighted.push_back({w.evenness, even});
     out.evenness = double(t.scalar(even));
+  }
+  if (w.transport > 0) {
+    // L_EMD on the first n samples and targets, 3D points (beyond the paper;
+    // losses/transport.h): every target gets a sample of its own.
+    const Index n = std::min<Index>(o.transport_points, m);
+    const Var emd = transport_loss(t, slice_rows(t, first_m(all.points), 0, n),
+                                   Block<T>(targets.topLeftCorner(n, 3)));
+    weighted.push_back({w.transport, emd});
   }
   if (w.metric > 0 && jacobian && o.metric_reference >= 0 && shape != o.metric_reference) {
     // L_metric (collections, beyond the paper; losses/isometry.h): the

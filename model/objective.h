@@ -25,6 +25,8 @@ struct LossWeights {
   double metric = 0;       // collections: on L_metric (beyond the paper; losses/isometry.h)
   double evenness = 0;     // on L_even, samples spread evenly (beyond the paper; losses/evenness.h)
   double map = 0;          // collections: on L_map, the pull of a spectral map (MapField below)
+  double transport =
+      0;  // on L_EMD, the exact assignment as a term (beyond the paper; losses/transport.h)
   // Inside L_6D: the weight of its coverage direction (each target's distance
   // to the nearest phi6(x_P)) against its accuracy direction; 1 is Eq. 6.
   double coverage = 1.0;
@@ -57,6 +59,8 @@ struct ObjectiveOptions {
   int metric_reference = -1;
   // L_metric compares the forms up to a scale per point (conformal_metric_mismatch).
   bool metric_conformal = false;
+  // L_EMD's n: the first n of the step's samples and targets (at most M).
+  Index transport_points = 256;
 };
 
 // Beyond the paper (issue 19, docs/collections.md, twelfth round): L_6D with

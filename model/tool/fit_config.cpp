@@ -60,6 +60,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
                   {"code", o.weights.code},
                   {"metric", o.weights.metric},
                   {"evenness", o.weights.evenness},
+                  {"transport", o.weights.transport},
                   {"coverage", o.weights.coverage},
                   {"convention", "mean over points (paper's 1/M factors folded in)"}};
   j["components"] = {{"normals", o.components.normals},
@@ -96,6 +97,8 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["template_max_steps"] = o.template_max_steps;
   j["chart_from"] = o.chart_from;
   j["evenness_from"] = o.evenness_from;
+  j["transport_from"] = o.transport_from;
+  j["transport_points"] = o.transport_points;
   j["metric_end"] = o.metric_end;
   j["metric_conformal"] = o.metric_conformal;
   j["code_lr_scale"] = o.code_lr_scale;
@@ -161,6 +164,10 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (w.contains("evenness")) field(w, "weights.", "evenness", o.weights.evenness);
   if (!(o.weights.evenness >= 0) || !std::isfinite(o.weights.evenness))
     throw InputError(what + ": weights.evenness must be finite and >= 0");
+  o.weights.transport = 0;  // later addition: absent = off
+  if (w.contains("transport")) field(w, "weights.", "transport", o.weights.transport);
+  if (!(o.weights.transport >= 0) || !std::isfinite(o.weights.transport))
+    throw InputError(what + ": weights.transport must be finite and >= 0");
   o.weights.coverage = 1;  // later addition: absent = Eq. 6's equal directions
   if (w.contains("coverage")) field(w, "weights.", "coverage", o.weights.coverage);
   if (!(o.weights.coverage >= 0) || !std::isfinite(o.weights.coverage))
@@ -264,6 +271,13 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (j.contains("evenness_from")) field(j, "", "evenness_from", o.evenness_from);
   if (!(o.evenness_from >= 0 && o.evenness_from <= 1))
     throw InputError(what + ": evenness_from must be in [0, 1]");
+  o.transport_from = 0.5;  // later addition: absent = off (weights.transport 0)
+  if (j.contains("transport_from")) field(j, "", "transport_from", o.transport_from);
+  if (!(o.transport_from >= 0 && o.transport_from <= 1))
+    throw InputError(what + ": transport_from must be in [0, 1]");
+  o.transport_points = 256;
+  if (j.contains("transport_points")) field(j, "", "transport_points", o.transport_points);
+  if (o.transport_points < 1) throw InputError(what + ": transport_points must be >= 1");
   o.template_max_steps = 0;  // later addition: absent = no cap
   if (j.contains("template_max_steps")) field(j, "", "template_max_steps", o.template_max_steps);
   if (o.template_max_steps < 0) throw InputError(what + ": template_max_steps must be >= 0");

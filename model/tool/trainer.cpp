@@ -39,7 +39,8 @@ static void validate(const FitOptions& o) {
       {o.weights.repulsion, "weights.repulsion must be >= 0 and finite"},
       {o.weights.code, "weights.code must be >= 0 and finite"},
       {o.weights.metric, "weights.metric must be >= 0 and finite"},
-      {o.weights.evenness, "weights.evenness must be >= 0 and finite"}};
+      {o.weights.evenness, "weights.evenness must be >= 0 and finite"},
+      {o.weights.transport, "weights.transport must be >= 0 and finite"}};
   for (const auto& [w, message] : weights) require(w >= 0 && std::isfinite(w), message);
   require(o.repulsion_tolerance > 0, "repulsion_tolerance must be positive");
   require(o.orient_every >= 0 && o.reseed_every >= 0 && o.wrap_steps >= 0,
@@ -50,6 +51,8 @@ static void validate(const FitOptions& o) {
   require(o.template_share >= 0 && o.template_share < 1, "template_share must be in [0, 1)");
   require(o.chart_from >= 0 && o.chart_from <= 1, "chart_from must be in [0, 1]");
   require(o.evenness_from >= 0 && o.evenness_from <= 1, "evenness_from must be in [0, 1]");
+  require(o.transport_from >= 0 && o.transport_from <= 1, "transport_from must be in [0, 1]");
+  require(o.transport_points >= 1, "transport_points must be >= 1");
   require(std::isfinite(o.metric_end), "metric_end must be finite (< 0: lambda_metric constant)");
   require(o.code_lr_scale > 0 && std::isfinite(o.code_lr_scale),
           "code_lr_scale must be positive and finite");
@@ -410,6 +413,9 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
     objective.components.chart = false;
   if (double(iteration_) < options_.evenness_from * double(options_.iterations))
     objective.weights.evenness = 0;
+  objective.transport_points = options_.transport_points;
+  if (double(iteration_) < options_.transport_from * double(options_.iterations))
+    objective.weights.transport = 0;
   // L_map: from the first joint step, falling linearly to 0 at spectral_map_until.
   const double map_end = options_.spectral_map_until * double(options_.iterations);
   const bool map_on =
