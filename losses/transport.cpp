@@ -6,26 +6,36 @@
 namespace jsa {
 
 template <class T>
-Var transport_loss(Tape<T>& t, Var x, const Block<T>& y) {
+Var transport_loss(Tape<T>& t, Var x, Var y) {
   const Index n = t.rows(x);
-  JSA_CHECK(n >= 1 && y.rows() == n && y.cols() == t.cols(x),
-            "transport_loss: " << n << " x " << t.cols(x) << " samples against " << y.rows()
-                               << " x " << y.cols() << " targets");
+  JSA_CHECK(n >= 1 && t.rows(y) == n && t.cols(y) == t.cols(x),
+            "transport_loss: " << n << " x " << t.cols(x) << " samples against " << t.rows(y)
+                               << " x " << t.cols(y) << " targets");
+  struct Scratch {
+    Block<double> cost;
+    Assignment sigma;
+    AssignmentWorkspace solver;
+  };
+  Scratch& s = t.template workspace<Scratch>();
   // sigma: the assignment of least total squared distance (Eq. 13's cost), in
   // double so that near-ties do not turn on float rounding.
   const Block<T>& xv = t.value(x);
-  Block<double> cost(n, n);
+  const Block<T>& yv = t.value(y);
+  s.cost.resize(n, n);
   for (Index i = 0; i < n; ++i)
     for (Index j = 0; j < n; ++j)
-      cost(i, j) =
-          (xv.row(i).template cast<double>() - y.row(j).template cast<double>()).squaredNorm();
-  const Assignment sigma = assign_lapjv(cost);
-  const Var matched = t.constant(Block<T>(n, y.cols()));
-  for (Index i = 0; i < n; ++i) t.value(matched).row(i) = y.row(sigma.column_of_row[size_t(i)]);
+      s.cost(i, j) =
+          (xv.row(i).template cast<double>() - yv.row(j).template cast<double>()).squaredNorm();
+  assign_lapjv(s.cost, s.sigma, s.solver);
+  // The matched targets, a constant: gathered after the node is made (making
+  // it may move the tape's blocks, so yv is read again through t.value).
+  const Var matched = t.constant(Block<T>::Zero(n, t.cols(y)));
+  for (Index i = 0; i < n; ++i)
+    t.value(matched).row(i) = t.value(y).row(s.sigma.column_of_row[size_t(i)]);
   return mean_squared_distance(t, x, matched);
 }
 
-template Var transport_loss<float>(Tape<float>&, Var, const Block<float>&);
-template Var transport_loss<double>(Tape<double>&, Var, const Block<double>&);
+template Var transport_loss<float>(Tape<float>&, Var, Var);
+template Var transport_loss<double>(Tape<double>&, Var, Var);
 
 }  // namespace jsa

@@ -14,9 +14,11 @@
 
 namespace jsa {
 
-// x: n x C samples on the tape; y: n x C targets (constants), the same n >= 1.
-// The value of L_EMD; its gradient reaches x through the matched pairs.
+// x: n x C samples on the tape; y: n x C targets, a constant on it, the same
+// n >= 1. The value of L_EMD; its gradient reaches x through the matched
+// pairs. The cost matrix, sigma and the solver's lists are the tape's
+// workspace (Tape::workspace): a step allocates nothing for them once warm.
 template <class T>
-Var transport_loss(Tape<T>& t, Var x, const Block<T>& y);
+Var transport_loss(Tape<T>& t, Var x, Var y);
 
 }  // namespace jsa

@@ -151,7 +151,7 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
     // losses/transport.h): every target gets a sample of its own.
     const Index n = std::min<Index>(o.transport_points, m);
     const Var emd = transport_loss(t, slice_rows(t, first_m(all.points), 0, n),
-                                   Block<T>(targets.topLeftCorner(n, 3)));
+                                   t.constant(targets.topLeftCorner(n, 3)));
     weighted.push_back({w.transport, emd});
   }
   if (w.metric > 0 && jacobian && o.metric_reference >= 0 && shape != o.metric_reference) {

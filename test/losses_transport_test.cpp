@@ -42,7 +42,7 @@ TEST_CASE("L_EMD is the least mean squared distance over every one-to-one matchi
   for (uint64_t seed : {1, 2, 3}) {
     const Block<double> x = uniform_block(7, 3, seed), y = uniform_block(7, 3, seed + 10);
     Tape<double> t;
-    const double value = t.scalar(transport_loss(t, t.constant(x), y));
+    const double value = t.scalar(transport_loss(t, t.constant(x), t.constant(y)));
     CHECK(value == Approx(best_over_permutations(x, y)).epsilon(1e-12));
   }
 }
@@ -55,7 +55,7 @@ TEST_CASE("L_EMD gives every target a sample of its own", "[transport]") {
   const Block<double> x = Block<double>::Zero(4, 3);
   Tape<double> t;
   const Var vx = t.constant(x);
-  const Var l = transport_loss(t, vx, y);
+  const Var l = transport_loss(t, vx, t.constant(y));
   CHECK(t.scalar(l) == Approx((0.0 + 1.0 + 4.0 + 9.0) / 4.0).epsilon(1e-14));
 }
 
@@ -64,7 +64,10 @@ TEST_CASE("L_EMD passes the finite-difference check in the samples", "[transport
   // finite-difference step.
   const Block<double> x = uniform_block(9, 3, 4), y = uniform_block(9, 3, 5);
   const GradCheckResult r = check_gradients(
-      [&](Tape<double>& t, const std::vector<Var>& v) { return transport_loss(t, v[0], y); }, {x});
+      [&](Tape<double>& t, const std::vector<Var>& v) {
+        return transport_loss(t, v[0], t.constant(y));
+      },
+      {x});
   INFO(r.report);
   CHECK(r.ok);
   CHECK(r.checked == 27);

@@ -251,3 +251,24 @@ TEST_CASE("LAPJV duality certificate on 2000 x 2000 squared distances", "[assign
   // Deterministic: a second solve gives the same matching.
   CHECK(assign_lapjv(c).column_of_row == a.column_of_row);
 }
+
+TEST_CASE("LAPJV with a kept workspace: the same solves as fresh ones, sizes up and down",
+          "[assignment]") {
+  // One result and one workspace carried through problems of changing n (the
+  // training step's L_EMD keeps them across steps): every solve must equal a
+  // solve from nothing, matching, cost and duals, whatever the previous one left.
+  Rng rng(7);
+  Assignment kept;
+  AssignmentWorkspace workspace;
+  for (int n : {6, 40, 1, 0, 40, 17, 3, 40}) {
+    const Block<double> c = n % 2 ? tied_costs(n, 4, rng) : uniform_costs(n, rng);
+    assign_lapjv(c, kept, workspace);
+    const Assignment fresh = assign_lapjv(c);
+    INFO("n = " << n);
+    CHECK(kept.column_of_row == fresh.column_of_row);
+    CHECK(kept.row_dual == fresh.row_dual);
+    CHECK(kept.column_dual == fresh.column_dual);
+    CHECK(kept.cost == fresh.cost);
+    CHECK(check_certificate(c, kept).proves_optimal(1e-12));
+  }
+}

@@ -67,6 +67,19 @@ TEST_CASE("trainer: steps 3 to 10 of a fit allocate nothing", "[trainer]") {
   }
 }
 
+TEST_CASE("trainer: ... with L_EMD's assignment in the step", "[trainer]") {
+  if (!allocation_counter::counting_available()) {
+    WARN("no allocation counting under a sanitizer");
+    return;
+  }
+  FitOptions o = small_options();
+  o.weights.transport = 0.1;  // from the first step, on 64 of the ramp's points
+  o.transport_from = 0;
+  o.transport_points = 64;
+  Trainer t(o, sphere_pool(4000, 1));
+  for (long n : step_allocations(t, 3, 8)) CHECK(n == 0);
+}
+
 TEST_CASE("trainer: ... and a collection's step, its shapes split over threads", "[trainer]") {
   if (!allocation_counter::counting_available()) {
     WARN("no allocation counting under a sanitizer");

@@ -30,16 +30,19 @@ namespace {
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 // The matching under construction: x (row -> column) and y (column -> row),
-// -1 where free, and the column prices v.
+// -1 where free, and the column prices v. x and v are the result's own
+// vectors (Assignment::column_of_row, column_dual), y the workspace's.
 struct Matching {
-  std::vector<int> column_of_row, row_of_column;
-  std::vector<double> price;  // v
+  std::vector<int>& column_of_row;
+  std::vector<int>& row_of_column;
+  std::vector<double>& price;  // v
 };
 
-// Phase 1. Returns the rows left free.
-std::vector<int> column_reduction(const Block<double>& cost, Matching& m) {
+// Phase 1. Leaves the rows still free in `free_rows`.
+void column_reduction(const Block<double>& cost, Matching& m, std::vector<int>& columns_won,
+                      std::vector<int>& free_rows) {
   const int n = int(cost.rows());
-  std::vector<int> columns_won(n, 0);  // how many columns chose each row
+  columns_won.assign(size_t(n), 0);  // how many columns chose each row
   // Right to left, as in the paper: the last column a row wins is the one it keeps.
   for (int j = n - 1; j >= 0; --j) {
     int cheapest_row = 0;
@@ -51,7 +54,7 @@ std::vector<int> column_reduction(const Block<double>& cost, Matching& m) {
       m.row_of_column[j] = cheapest_row;
     }
   }
-  std::vector<int> free_rows;
+  free_rows.clear();
   for (int i = 0; i < n; ++i) {
     if (columns_won[i] == 0) {
       free_rows.push_back(i);
@@ -65,17 +68,17 @@ std::vector<int> column_reduction(const Block<double>& cost, Matching& m) {
       m.price[held] -= second;  // second >= 0: all prices are column minima here
     }
   }
-  return free_rows;
 }
 
-// Phase 2, one pass over `free_rows`; returns the rows still free afterwards.
-// `bid_budget` caps the work: in floating point a price drop can round to
-// nothing and two rows could evict each other forever. Rows left when the
-// budget runs out simply stay free for phase 3, which handles any free row.
-std::vector<int> augmenting_row_reduction(const Block<double>& cost, std::vector<int> free_rows,
-                                          Matching& m, long& bid_budget) {
+// Phase 2, one pass over `free_rows`; the rows still free afterwards are left
+// in `still_free`. `bid_budget` caps the work: in floating point a price drop
+// can round to nothing and two rows could evict each other forever. Rows left
+// when the budget runs out simply stay free for phase 3, which handles any
+// free row.
+void augmenting_row_reduction(const Block<double>& cost, std::vector<int>& free_rows, Matching& m,
+                              long& bid_budget, std::vector<int>& still_free) {
   const int n = int(cost.rows());
-  std::vector<int> still_free;
+  still_free.clear();
   size_t k = 0;
   while (k < free_rows.size()) {
     const int i = free_rows[k++];
@@ -129,18 +132,17 @@ std::vector<int> augmenting_row_reduction(const Block<double>& cost, std::vector
         still_free.push_back(evicted);
     }
   }
-  return still_free;
 }
 
-// Scratch space for phase 3, allocated once per solve. Every loop over the
-// columns runs over all n of them, contiguous, so the compiler can vectorize
-// it; settled columns are masked out by `closed` instead of being skipped.
+// Scratch space for phase 3 (the workspace's arrays, sized once per solve).
+// Every loop over the columns runs over all n of them, contiguous, so the
+// compiler can vectorize it; settled columns are masked out by `closed`
+// instead of being skipped.
 struct PathSearch {
-  explicit PathSearch(int n) : distance(n), closed(n), predecessor(n) { settled.reserve(n); }
-  std::vector<double> distance;  // shortest alternating-path length to each column
-  std::vector<double> closed;    // 0 while a column is open, +inf once settled
-  std::vector<int> predecessor;  // the row before each column on its shortest path
-  std::vector<int> settled;      // settled columns, in order
+  std::vector<double>& distance;  // shortest alternating-path length to each column
+  std::vector<double>& closed;    // 0 while a column is open, +inf once settled
+  std::vector<int>& predecessor;  // the row before each column on its shortest path
+  std::vector<int>& settled;      // settled columns, in order
 };
 
 // path_length(j) = c_rj - v_j - offset; keep it where it beats distance[j] on
@@ -238,41 +240,52 @@ void augment(const Block<double>& cost, int start_row, Matching& m, PathSearch& 
 
 }  // namespace
 
-Assignment assign_lapjv(const Block<double>& cost) {
+void assign_lapjv(const Block<double>& cost, Assignment& result, AssignmentWorkspace& w) {
   JSA_CHECK(cost.rows() == cost.cols(),
             "assignment needs a square cost matrix, got " << cost.rows() << " x " << cost.cols());
   JSA_CHECK(cost.rows() < std::numeric_limits<int>::max(), "cost matrix too large");
   JSA_CHECK(cost.allFinite(), "assignment costs must be finite");
   const int n = int(cost.rows());
-  Assignment result;
-  if (n == 0) return result;
-  Matching m;
-  m.column_of_row.assign(n, -1);
-  m.row_of_column.assign(n, -1);
-  m.price.assign(n, 0.0);
+  result.cost = 0;
+  // assign() and resize() keep the vectors' capacity: a second solve of the
+  // same n allocates nothing.
+  result.column_of_row.assign(size_t(n), -1);
+  result.column_dual.assign(size_t(n), 0.0);
+  result.row_dual.resize(size_t(n));
+  w.row_of_column.assign(size_t(n), -1);
+  if (n == 0) return;
+  Matching m{result.column_of_row, w.row_of_column, result.column_dual};
   if (n == 1) {
     m.column_of_row[0] = m.row_of_column[0] = 0;
     m.price[0] = cost(0, 0);
   } else {
-    std::vector<int> free_rows = column_reduction(cost, m);
+    column_reduction(cost, m, w.columns_won, w.free_rows);
     long bid_budget = 16L * n;
-    for (int pass = 0; pass < 2 && !free_rows.empty(); ++pass)
-      free_rows = augmenting_row_reduction(cost, std::move(free_rows), m, bid_budget);
-    PathSearch search(n);
-    for (int row : free_rows) augment(cost, row, m, search);
+    for (int pass = 0; pass < 2 && !w.free_rows.empty(); ++pass) {
+      augmenting_row_reduction(cost, w.free_rows, m, bid_budget, w.still_free);
+      std::swap(w.free_rows, w.still_free);
+    }
+    w.distance.resize(size_t(n));
+    w.closed.resize(size_t(n));
+    w.predecessor.resize(size_t(n));
+    w.settled.reserve(size_t(n));
+    PathSearch search{w.distance, w.closed, w.predecessor, w.settled};
+    for (int row : w.free_rows) augment(cost, row, m, search);
   }
-  result.column_of_row = m.column_of_row;
-  result.column_dual = m.price;
-  result.row_dual.resize(n);
   for (int i = 0; i < n; ++i) {
     const int j = m.column_of_row[i];
     JSA_CHECK(j >= 0 && m.row_of_column[j] == i, "LAPJV left row " << i << " unmatched");
     result.row_dual[i] = cost(i, j) - m.price[j];
     result.cost += cost(i, j);
   }
-  return result;
 }
 
+Assignment assign_lapjv(const Block<double>& cost) {
+  Assignment result;
+  AssignmentWorkspace workspace;
+  assign_lapjv(cost, result, workspace);
+  return result;
+}
 AssignmentCertificate check_certificate(const Block<double>& cost, const Assignment& a) {
   const Index n = cost.rows();
   JSA_CHECK(cost.cols() == n, "square cost matrix expected");

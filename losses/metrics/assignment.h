@@ -28,6 +28,20 @@ struct Assignment {
 // expect a particular one of them; the cost is what is unique.
 Assignment assign_lapjv(const Block<double>& cost);
 
+// The solver's lists (the matching under construction, the free rows, the
+// shortest-path search's arrays), kept by a caller that solves one problem
+// after another: the training step's L_EMD (losses/transport.h), which must
+// not allocate once warm.
+struct AssignmentWorkspace {
+  std::vector<int> row_of_column, columns_won, free_rows, still_free;
+  std::vector<int> predecessor, settled;
+  std::vector<double> distance, closed;
+};
+
+// The same solve into `result`, its vectors and `workspace`'s reused: no
+// allocation once both have held a problem of this n.
+void assign_lapjv(const Block<double>& cost, Assignment& result, AssignmentWorkspace& workspace);
+
 // How far (u, v) are from proving `assignment` optimal for `cost`.
 struct AssignmentCertificate {
   bool is_permutation = false;         // column_of_row is a permutation of 0..n-1
