@@ -11,17 +11,12 @@
 #include "engine/parallel.h"
 #include "engine/rng.h"
 #include "losses/chamfer.h"
+#include "test/uniform_block.h"
 
 using namespace jsa;
+using test_support::uniform_block;
 
 namespace {
-
-Block<double> random_block(Index n, Index c, uint64_t seed) {
-  Rng rng(seed);
-  Block<double> b(n, c);
-  for (Index i = 0; i < b.size(); ++i) b.data()[i] = rng.uniform(-1, 1);
-  return b;
-}
 
 // 1/N sum_i min_j |x_i - y_j|^2, the obvious way.
 double one_way(const Block<double>& x, const Block<double>& y) {
@@ -59,7 +54,7 @@ double smallest_match_gap(const Block<double>& x, const Block<double>& y) {
 
 TEST_CASE("chamfer value equals the brute-force double loop", "[chamfer]") {
   for (Index c : {2, 3, 6}) {
-    const Block<double> x = random_block(300, c, 100 + c), y = random_block(250, c, 200 + c);
+    const Block<double> x = uniform_block(300, c, 100 + c), y = uniform_block(250, c, 200 + c);
     const double expected = one_way(x, y) + one_way(y, x);
     Tape<double> t;
     ChamferMatches<double> m;
@@ -78,7 +73,7 @@ TEST_CASE("chamfer value equals the brute-force double loop", "[chamfer]") {
 }
 
 TEST_CASE("chamfer of a set with itself is zero", "[chamfer]") {
-  const Block<double> x = random_block(100, 3, 7);
+  const Block<double> x = uniform_block(100, 3, 7);
   CHECK(chamfer_distance(x, x) == 0);
 }
 
@@ -86,7 +81,7 @@ TEST_CASE("chamfer gradient passes the finite-difference check", "[chamfer]") {
   // Random points are in general position: the nearest and second-nearest
   // squared distances of every query differ by far more than the step (1e-6
   // relative), so no match flips during the check and the loss is smooth there.
-  const Block<double> x = random_block(40, 3, 300), y = random_block(30, 3, 301);
+  const Block<double> x = uniform_block(40, 3, 300), y = uniform_block(30, 3, 301);
   REQUIRE(smallest_match_gap(x, y) > 1e-4);
   REQUIRE(smallest_match_gap(y, x) > 1e-4);
   const GradCheckResult r = check_gradients(
@@ -95,7 +90,7 @@ TEST_CASE("chamfer gradient passes the finite-difference check", "[chamfer]") {
   CHECK(r.ok);
 
   // 2D, the L_2D shape, and chamfer feeding further ops (gradient scaled on the way).
-  const Block<double> u = random_block(25, 2, 310), w = random_block(35, 2, 311);
+  const Block<double> u = uniform_block(25, 2, 310), w = uniform_block(35, 2, 311);
   REQUIRE(smallest_match_gap(u, w) > 1e-4);
   REQUIRE(smallest_match_gap(w, u) > 1e-4);
   const GradCheckResult r2 = check_gradients(
@@ -150,8 +145,8 @@ TEST_CASE("chamfer accumulates gradients on shared matches", "[chamfer]") {
 }
 
 TEST_CASE("chamfer with a constant side only differentiates the other", "[chamfer]") {
-  const Block<float> x = random_block(50, 6, 500).cast<float>(),
-                     y = random_block(60, 6, 501).cast<float>();
+  const Block<float> x = uniform_block(50, 6, 500).cast<float>(),
+                     y = uniform_block(60, 6, 501).cast<float>();
   Tape<float> t;
   Var vx = t.variable(x), vy = t.constant(y);
   Var loss = chamfer(t, vx, vy);
@@ -171,8 +166,8 @@ TEST_CASE("chamfer with a constant side only differentiates the other", "[chamfe
 
 TEST_CASE("chamfer gradients do not depend on the thread count", "[chamfer]") {
   // Enough rows that the own-row pull-back runs in several parallel chunks.
-  const Block<float> x = random_block(9000, 3, 700).cast<float>();
-  const Block<float> y = random_block(7000, 3, 701).cast<float>();
+  const Block<float> x = uniform_block(9000, 3, 700).cast<float>();
+  const Block<float> y = uniform_block(7000, 3, 701).cast<float>();
   auto gradients = [&](int threads) {
     set_threads(threads);
     Tape<float> t;
@@ -190,8 +185,8 @@ TEST_CASE("chamfer gradients do not depend on the thread count", "[chamfer]") {
 TEST_CASE("dense chamfer: x searches the pool, y searches x", "[chamfer]") {
   // Value: 1/N sum_i min over the pool + 1/M sum_j min over x, by double loops.
   for (Index c : {3, 6}) {
-    const Block<double> x = random_block(120, c, 800 + c), y = random_block(90, c, 810 + c);
-    const Block<double> pool = random_block(2000, c, 820 + c);
+    const Block<double> x = uniform_block(120, c, 800 + c), y = uniform_block(90, c, 810 + c);
+    const Block<double> pool = uniform_block(2000, c, 820 + c);
     const NearestIndex<double> surface(pool);
     const double expected = one_way(x, pool) + one_way(y, x);
     Tape<double> t;
@@ -205,7 +200,7 @@ TEST_CASE("dense chamfer: x searches the pool, y searches x", "[chamfer]") {
             Approx((x.row(i) - pool.row(m.x_to_y[size_t(i)])).squaredNorm()));
   }
   // When the pool is y itself, the dense op is Eq. (6) exactly, gradients too.
-  const Block<double> x = random_block(60, 6, 830), y = random_block(50, 6, 831);
+  const Block<double> x = uniform_block(60, 6, 830), y = uniform_block(50, 6, 831);
   const NearestIndex<double> same(y);
   Tape<double> t1, t2;
   Var x1 = t1.variable(x), x2 = t2.variable(x);
@@ -217,8 +212,8 @@ TEST_CASE("dense chamfer: x searches the pool, y searches x", "[chamfer]") {
 TEST_CASE("dense chamfer gradient passes the finite-difference check", "[chamfer]") {
   // x and y are variables, the pool a constant: dL/dy has only the own-row
   // term (y's matches in x), dL/dx both. Matches are stable (general position).
-  const Block<double> x = random_block(40, 6, 840), y = random_block(30, 6, 841);
-  const Block<double> pool = random_block(500, 6, 842);
+  const Block<double> x = uniform_block(40, 6, 840), y = uniform_block(30, 6, 841);
+  const Block<double> pool = uniform_block(500, 6, 842);
   REQUIRE(smallest_match_gap(x, pool) > 1e-4);
   REQUIRE(smallest_match_gap(y, x) > 1e-4);
   const NearestIndex<double> surface(pool);
@@ -232,8 +227,8 @@ TEST_CASE("dense chamfer gradient passes the finite-difference check", "[chamfer
 TEST_CASE("chamfer's coverage weight scales the second direction, value and gradient",
           "[chamfer]") {
   // L_w = 1/N sum_i min_j |x_i - y_j|^2 + w/M sum_j min_i |y_j - x_i|^2, plain and dense.
-  const Block<double> x = random_block(40, 6, 850), y = random_block(30, 6, 851);
-  const Block<double> pool = random_block(500, 6, 852);
+  const Block<double> x = uniform_block(40, 6, 850), y = uniform_block(30, 6, 851);
+  const Block<double> pool = uniform_block(500, 6, 852);
   REQUIRE(smallest_match_gap(x, y) > 1e-4);
   REQUIRE(smallest_match_gap(y, x) > 1e-4);
   REQUIRE(smallest_match_gap(x, pool) > 1e-4);
@@ -267,8 +262,8 @@ TEST_CASE("chamfer's coverage weight scales the second direction, value and grad
 TEST_CASE("chamfer timing at training-loop sizes", "[.bench][chamfer]") {
   // L_6D shape: 10^4 x 10^4 points in 6 columns, float, forward + backward:
   // xyz in a cube, the last three columns scaled to ~0.01 like the normals.
-  Block<float> x = random_block(10000, 6, 600).cast<float>();
-  Block<float> y = random_block(10000, 6, 601).cast<float>();
+  Block<float> x = uniform_block(10000, 6, 600).cast<float>();
+  Block<float> y = uniform_block(10000, 6, 601).cast<float>();
   x.rightCols(3) *= 0.01f;
   y.rightCols(3) *= 0.01f;
   Tape<float> t;

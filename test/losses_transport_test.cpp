@@ -9,20 +9,14 @@
 #include <vector>
 
 #include "engine/gradcheck.h"
-#include "engine/rng.h"
 #include "engine/tape.h"
 #include "losses/transport.h"
+#include "test/uniform_block.h"
 
 using namespace jsa;
+using test_support::uniform_block;
 
 namespace {
-Block<double> uniform_block(Index rows, Index cols, uint64_t seed) {
-  Rng rng(seed);
-  Block<double> b(rows, cols);
-  for (Index i = 0; i < b.size(); ++i) b.data()[i] = rng.uniform(-1, 1);
-  return b;
-}
-
 // min over every permutation s of (1/n) sum_i |x_i - y_s(i)|^2.
 double best_over_permutations(const Block<double>& x, const Block<double>& y) {
   std::vector<int> s(size_t(x.rows()));
