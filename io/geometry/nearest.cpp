@@ -187,16 +187,23 @@ void query_tree(const KdTree<T, Dim>& tree, const Block<T>& queries, std::vector
     index[i] = int(best.index());
     if (dist) dist[i] = best.distance();
   };
-  // Small batches stay serial: a parallel region costs more than it saves, and
-  // far more when another process holds the second core; so do searches inside
-  // another team (the trainer's shape workers), where a region would have one
-  // thread and cost a heap block (engine/parallel.h, region_would_be_serial).
-  if (m <= 1024 || region_would_be_serial()) {
+  // Tiny batches stay serial: a parallel region costs more than it saves; so do
+  // searches inside another team (the trainer's shape workers), where a region
+  // would have one thread and cost a heap block (engine/parallel.h,
+  // region_would_be_serial). The cut-off was 1024 queries; the ramp's first
+  // level (M = 625 against the 200k-point pool, phi still far from the surface,
+  // where each query visits many cells) then searched on one core while the
+  // other waited, and its steps took 8% longer (docs/performance.md, "The
+  // first level's searches"). Chunks of a sixteenth keep both threads busy to
+  // the end of a small batch.
+  if (m <= 128 || region_would_be_serial()) {
     for (Index j = 0; j < m; ++j) answer(j);
     return;
   }
-#pragma omp parallel for schedule(dynamic, 256)
-  for (Index j = 0; j < m; ++j) answer(j);
+  const Index chunk = std::clamp<Index>(m / 16, 32, 256);
+#pragma omp parallel for schedule(dynamic)
+  for (Index first = 0; first < m; first += chunk)
+    for (Index j = first; j < std::min(m, first + chunk); ++j) answer(j);
 }
 
 template <class T, int Dim>
