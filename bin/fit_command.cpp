@@ -53,7 +53,10 @@ struct FitArgs {
   int mesh_resolution = 256;
   double mesh_threshold = 0.05;
   std::string texture;
-  double minutes = 0;   // > 0: size --iters to this wall-time budget
+  double minutes = 0;  // > 0: size --iters to this wall-time budget
+  // Under --minutes, the steps a single shape's run should have at least: a
+  // shorter budget takes a smaller M instead (budgeted_points). -1: not given.
+  int64_t min_steps = -1;
   int64_t stop_at = 0;  // > 0: stop after this iteration with a checkpoint (continue with --resume)
   bool quiet = false;
   int64_t inject_fault_at = -1;  // tests only: one NaN loss at this iteration
@@ -729,8 +732,29 @@ void run_fit(FitArgs& a, Team& team) {
       const double timed_cost =
           scheduled_mean_cost(o.schedule, o.points, kStepOverheadPoints, first + warmup,
                               first + warmup + probe, o.iterations);
+      const double per_cost = per / timed_cost;
+      // A budget too short for the steps a fit needs at this M takes a
+      // smaller M (model/tool/schedule.h, budgeted_points): a single shape's
+      // run asks for kBudgetMinSteps unless told; an M given with -M is kept,
+      // and collections and --preset paper keep theirs (not measured).
+      const int64_t min_steps =
+          a.min_steps >= 0 ? a.min_steps
+                           : (inputs.size() == 1 && a.preset.empty() ? kBudgetMinSteps : 0);
+      if (!a.points_given && min_steps > 0) {
+        const Index m = Index(rank0_value(
+            double(budgeted_points(o.schedule, o.points, kStepOverheadPoints, per_cost, 0.97 * left,
+                                   min_steps, Index(kBudgetLeastPoints * double(o.points))))));
+        if (m < o.points) {
+          if (!a.quiet)
+            std::cerr << "fit: " << a.minutes << " min holds fewer than " << min_steps
+                      << " steps at M = " << o.points << "; M = " << m
+                      << " instead (--min-steps)\n";
+          o.points = m;
+          trainer.set_points(m);
+        }
+      }
       const double mean_step =
-          per / timed_cost * scheduled_run_cost(o.schedule, o.points, kStepOverheadPoints);
+          per_cost * scheduled_run_cost(o.schedule, o.points, kStepOverheadPoints);
       const int64_t n = int64_t(rank0_value(
           double(warmup + probe + std::max<int64_t>(1, int64_t(left / mean_step * 0.97)))));
       trainer.set_iterations(n);
@@ -982,6 +1006,13 @@ void add_fit(CLI::App& app) {
                 "Time budget: after 5 warm-up and 20 timed iterations, set --iters to fill it (the "
                 "schedule follows; the ramp's later, larger steps counted in)")
       ->check(CLI::Range(0.01, 100000.0));
+  c->add_option("--min-steps", a->min_steps,
+                "With --minutes: the steps a single shape's run should have at least; a budget "
+                "too short for them at M takes a smaller M (down to M/2; 0: keep M; default " +
+                    std::to_string(kBudgetMinSteps) +
+                    " for a single shape, 0 for collections and --preset paper; an M given "
+                    "with -M is kept)")
+      ->check(CLI::Range(int64_t(0), int64_t(100000000)));
   c->add_option("--stop-at", a->stop_at,
                 "Stop after this iteration with a checkpoint, exit 0; continue with --resume (job "
                 "time limits; the schedule is --iters')")

@@ -400,6 +400,37 @@ TEST_CASE("cli: the schedule's flags are saved, collections keep M fixed, a shor
   CHECK(settings(dir + "_capped")["template_max_steps"] == 40);
 }
 
+// --min-steps (model/tool/schedule.h, budgeted_points): a budget that holds
+// fewer steps than asked at M takes a smaller M, down to M/2. No budget holds
+// 10^8 steps, so whatever this machine's speed the default M = 2500 becomes
+// 1250; an M given with -M, --min-steps 0 and a collection keep theirs.
+TEST_CASE("cli: a budget too short for --min-steps halves M, unless -M, 0 or a collection",
+          "[cli][schedule]") {
+  const std::string dir = fresh_dir("min_steps");
+  const std::string tiny =
+      " --minutes 0.01 --iters 3 -K 200 --width 16 --depth 2 --threads 1 --pool 5000"
+      " --mesh-resolution 32 --checkpoint-every 0";
+  auto points = [](const std::string& run) {
+    return nlohmann::json::parse(read_text(run + "/config.json"))["settings"]["points"];
+  };
+  Result r = run("fit builtin:sphere -o " + dir + "_halved --min-steps 100000000" + tiny);
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  CHECK(points(dir + "_halved") == 1250);
+  CHECK(r.output.find("M = 1250 instead (--min-steps)") != std::string::npos);
+  r = run("fit builtin:sphere -o " + dir + "_given --min-steps 100000000 -M 2000 -q" + tiny);
+  REQUIRE(r.code == 0);
+  CHECK(points(dir + "_given") == 2000);
+  r = run("fit builtin:sphere -o " + dir + "_off --min-steps 0 -q" + tiny);
+  REQUIRE(r.code == 0);
+  CHECK(points(dir + "_off") == 2500);
+  r = run("fit builtin:sphere builtin:torus -o " + dir + "_pair --template-steps 0 --no-align -q" +
+          tiny);
+  REQUIRE(r.code == 0);
+  CHECK(points(dir + "_pair") == jsa::kCollectionPoints);
+  CHECK(run("fit builtin:sphere -o " + dir + "_bad --min-steps -1 -q" + tiny).code == 2);
+}
+
 // --gemm (engine/gemm.h, model/tool/gemm_choice.h): the backend is a setting,
 // saved and resumed; a fixed one gives the same bits twice, here with a
 // collection's shapes split over two threads (each worker's products inside an

@@ -321,3 +321,41 @@ TEST_CASE(
   // No time for even one step: one more step, not a run that never ends.
   CHECK(jsa::budgeted_iterations(ramp, m, overhead, 100, n, decay, 1.0, 1e-9) == 101);
 }
+
+TEST_CASE(
+    "budgeted_points: a budget too short for the steps asked takes the largest M that holds "
+    "them",
+    "[tool][schedule]") {
+  jsa::ScheduleOptions ramp;
+  const jsa::Index m = 2500, least = 625;
+  const double overhead = jsa::kStepOverheadPoints, per_cost = 1e-5;  // seconds per cost unit
+  const double full_run = jsa::scheduled_run_cost(ramp, m, overhead) * per_cost;  // s per step
+  // Time for 2000 steps at M = 2500: kept at 1500 and 2000 steps asked, and with none asked.
+  CHECK(jsa::budgeted_points(ramp, m, overhead, per_cost, 2000 * full_run, 1500, least) == m);
+  CHECK(jsa::budgeted_points(ramp, m, overhead, per_cost, 2000 * full_run, 2000, least) == m);
+  CHECK(jsa::budgeted_points(ramp, m, overhead, per_cost, 2000 * full_run, 0, least) == m);
+  // 3000 steps asked: a smaller M whose run holds them, and the largest such
+  // (one point more would not).
+  const double left = 2000 * full_run;
+  const jsa::Index k = jsa::budgeted_points(ramp, m, overhead, per_cost, left, 3000, least);
+  REQUIRE(k < m);
+  REQUIRE(k > least);
+  auto steps = [&](jsa::Index p) {
+    return left / (per_cost * jsa::scheduled_run_cost(ramp, p, overhead));
+  };
+  CHECK(steps(k) >= 3000);
+  CHECK(steps(k + 1) < 3000);
+  // The ramp's mean step costs overhead + 0.71875 M (four levels of 3/16 of
+  // the run at 1/4, 1/2, 3/4 and 1 of M, then M): 2000 steps at M = 2500 hold
+  // 3000 at M = (2000 x 2046.9 / 3000 - 250) / 0.71875 = 1551.
+  CHECK(k >= 1549);
+  CHECK(k <= 1552);
+  // Not even the least M holds them: the least M; a fixed M shrinks alike.
+  CHECK(jsa::budgeted_points(ramp, m, overhead, per_cost, left, 100000, least) == least);
+  jsa::ScheduleOptions step;
+  step.kind = "step";
+  const jsa::Index f = jsa::budgeted_points(step, m, overhead, per_cost,
+                                            2000 * (overhead + m) * per_cost, 4000, least);
+  CHECK(f >= 1124);  // 2000 x 2750 / 4000 - 250 = 1125, within the rounding of the test
+  CHECK(f <= 1125);
+}

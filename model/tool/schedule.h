@@ -167,4 +167,34 @@ inline int64_t budgeted_iterations(const ScheduleOptions& s, Index points, doubl
   return n;
 }
 
+// Sizing M to a short budget (`jsatlas fit --minutes`, `--min-steps`): the
+// largest final M, between `least` and `points`, whose whole run of
+// `min_steps` steps fits in `seconds_left` at `seconds_per_cost` (seconds per
+// unit of modelled cost, overhead + M, measured on the run's first steps).
+// A short fit needs its steps more than its points: at one minute of two
+// cores a SHREC ant bought 990-1130 steps at M = 2500 and 2000 at M = 1200,
+// and the fewer, finer steps left 2.4-4.0% of its surface inside out against
+// 0.9-1.9% (docs/results.md, "M sized to the budget"). `points` when the
+// budget already holds min_steps at it; `least` when not even that M does.
+inline Index budgeted_points(const ScheduleOptions& s, Index points, double overhead,
+                             double seconds_per_cost, double seconds_left, int64_t min_steps,
+                             Index least) {
+  least = std::min(least, points);
+  if (min_steps <= 0 || !(seconds_per_cost > 0)) return points;
+  auto steps_at = [&](Index m) {
+    return seconds_left / (seconds_per_cost * scheduled_run_cost(s, m, overhead));
+  };
+  if (steps_at(points) >= double(min_steps)) return points;
+  // A run's cost grows with M: the largest M whose run holds min_steps.
+  Index lo = least, hi = points;
+  while (lo < hi) {
+    const Index mid = lo + (hi - lo + 1) / 2;
+    if (steps_at(mid) >= double(min_steps))
+      lo = mid;
+    else
+      hi = mid - 1;
+  }
+  return lo;
+}
+
 }  // namespace jsa

@@ -234,6 +234,22 @@ inline void apply_paper_method(FitOptions& o) {
 // collections' defaults (the template start, docs/collections.md) at fixed M.
 constexpr int64_t kFixedScheduleIterations = 5000;
 
+// `jsatlas fit --minutes` on a single shape: the steps a run should have at
+// least (`--min-steps`); a budget too short for them at the default M takes a
+// smaller M, down to kBudgetLeastPoints of it (budgeted_points,
+// model/tool/schedule.h). Measured one run after another on two cores
+// (docs/results.md, "M sized to the budget"): at one minute M = 1200 (about
+// 2000 steps) against M = 2500 (about 1050) took ant_1's Chamfer / normals
+// from 1.28 / 2.05 to 1.12 / 1.52x the floor and was better on teddy_1,
+// teddy_3 and the torus; at two minutes M = 1200 (3700-3900 steps) beat 1600
+// and 2500 on ant_1 and teddy_3; at five minutes it was level or better
+// (ant_1 normals 1.16 -> 1.13, teddy_3 1.27 -> 1.20); M = 800 was no better
+// than 1200 at one minute. 4000 steps leave this machine's five minutes (4900-6100
+// steps planned) at M = 2500, the default measured there on four shapes and
+// two seeds, and halve M on budgets of about two minutes and less.
+constexpr int64_t kBudgetMinSteps = 4000;
+constexpr double kBudgetLeastPoints = 0.5;
+
 // `jsatlas fit`'s sizes for collections, unless given: M = K = 1000 and 5 x 64
 // MLPs. At 10 minutes of one core on SHREC ant and teddy (docs/collections.md,
 // fourth round) they beat 5 x 128 and the single-shape M = K = 2500 on the
@@ -392,6 +408,10 @@ class Trainer {
   // Changes the length of the run (and so the learning-rate schedule) before it
   // reaches its first decay point: used to fit a run to a time budget.
   void set_iterations(int64_t n) { options_.iterations = n; }
+  // Changes the final M (the ramp's levels follow): used to fit a run to a
+  // budget too short for its steps at the M asked (budgeted_points). The next
+  // step takes the new M as it takes a level change.
+  void set_points(Index m) { options_.points = m; }
   Atlas<float>& atlas() { return *atlas_; }
   const FitOptions& options() const { return options_; }
   // The full state (parameters, Adam, RNG, iteration and fault record), for checkpoints.
