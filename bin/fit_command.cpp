@@ -119,6 +119,10 @@ auto with_flag_names(F&& f) {
       {"intrinsic_until", "--intrinsic-until"},
       {"spectral_map", "--spectral-map"},
       {"spectral_map_until", "--spectral-map-until"},
+      {"register_prior", "--register-prior"},
+      {"nodes_lr_scale", "--nodes-lr-scale"},
+      {"nodes_width", "--nodes-width"},
+      {"atlas.deform_nodes", "--deform-nodes"},
       {"schedule.kind", "--schedule"},
       {"schedule.points_start", "--points-start"},
       {"schedule.ramp_until", "--ramp-until"},
@@ -270,6 +274,10 @@ void run_fit(FitArgs& a, Team& team) {
       throw InputError("--intrinsic: needs a collection (two or more inputs)");
     if (o.spectral_map > 0 && inputs.size() < 2)
       throw InputError("--spectral-map: needs a collection (two or more inputs)");
+    if (o.atlas.deform_nodes > 0 && inputs.size() < 2)
+      throw InputError("--deform-nodes: needs a collection (two or more inputs)");
+    if (o.register_nodes && o.atlas.deform_nodes == 0)
+      throw InputError("--register: needs --deform-nodes > 0");
     if (o.atlas.deform_domain && (inputs.size() < 2 || o.atlas.deform_layers == 0))
       throw InputError(
           "--deform-domain: needs a collection (two or more inputs) with --deform-layers > 0");
@@ -501,14 +509,22 @@ void run_fit(FitArgs& a, Team& team) {
     }
   }
   Trainer trainer = make_trainer(o, pools, &team);
-  if (o.spectral_map > 0) {
-    // L_map's maps (model/tool/spectral_start.h), from the meshes in their
-    // fit's frames; a resumed run finds the same ones (they depend on nothing else).
-    if (many) throw InputError("--spectral-map: not over MPI yet");
+  // --register's registration is needed once, before the joint training (a
+  // checkpoint is only written after it: a resumed run has its nodes).
+  const bool registers = o.register_nodes && !resuming;
+  if (o.spectral_map > 0 || registers) {
+    // L_map's maps and --register's registration (model/tool/spectral_start.h),
+    // from the meshes in their fit's frames; a resumed run finds the same ones
+    // (they depend on nothing else).
+    if (many)
+      throw InputError(o.spectral_map > 0 ? "--spectral-map: not over MPI yet"
+                                          : "--register: not over MPI yet");
     const auto s0 = std::chrono::steady_clock::now();
     std::vector<Mesh> meshes;
     for (const RunInput& s : shapes) meshes.push_back(s.mesh);
-    const SpectralStart start = spectral_start(meshes, frames, o.template_shape);
+    SpectralStartOptions so;
+    so.prior_weight = o.register_prior;
+    const SpectralStart start = spectral_start(meshes, frames, o.template_shape, so);
     trainer.set_spectral_map(start.template_vertices, start.images);
     const double took =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();
@@ -661,6 +677,18 @@ void run_fit(FitArgs& a, Team& team) {
       std::cerr << "fit: template start: shape " << o.template_shape << " alone for "
                 << o.template_steps << " steps (" << format_duration(seconds) << ", L "
                 << trainer.last().total << "), its codes copied to every shape\n";
+    const NodePlacementReport& nodes = trainer.node_report();
+    if (!a.quiet && !nodes.target_rms.empty()) {
+      std::fprintf(stderr, "fit: %d nodes in the domain, sigma %.4g", o.atlas.deform_nodes,
+                   nodes.sigma);
+      if (o.register_nodes) {
+        std::fprintf(stderr, "; registration RMS / left by the nodes:");
+        for (size_t i = 0; i < nodes.target_rms.size(); ++i)
+          if (int(i) != o.template_shape)
+            std::fprintf(stderr, " %.3g / %.3g", nodes.target_rms[i], nodes.residual_rms[i]);
+      }
+      std::fprintf(stderr, "\n");
+    }
   }
   if (a.inject_fault_at >= 0) trainer.inject_faults(a.inject_fault_at, 1);
   const auto start = clock::now();
@@ -1142,6 +1170,35 @@ void add_fit(CLI::App& app) {
        "Collections of meshes: lambda_map, the pull of each shape towards the image of "
        "the template under a map between their Laplace-Beltrami eigenfunctions (ZoomOut), "
        "which an arm's pose does not change; fades to 0 over --spectral-map-until (0: off)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e3))
+      ->check(kFinite);
+  c->add_option(
+       "--deform-nodes", o.atlas.deform_nodes,
+       "Collections: add to phi_i a displacement sum_k w_k(x) t_k,i over this many "
+       "normalised Gaussian kernels in the domain, placed after the template start, which can move "
+       "a part that touches another in 3D alone (0: none)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 4096));
+  c->add_flag("--register", o.register_nodes,
+              "Collections of meshes, with --deform-nodes: start each shape's node displacements "
+              "from a spectral registration of the template to it (ZoomOut), fitted by least "
+              "squares, so the maps decide the correspondence and the training refines it");
+  c->add_option("--nodes-lr-scale", o.nodes_lr_scale,
+                "With --deform-nodes: learning rate of the node displacements as a multiple of "
+                "the rest's (0: they keep the registration's start)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e3))
+      ->check(kFinite);
+  c->add_option("--nodes-width", o.nodes_width,
+                "With --deform-nodes: the kernels' width as a multiple of the centres' spacing in "
+                "the domain (wider: a smoother displacement)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 100.0))
+      ->check(kFinite);
+  c->add_option("--register-prior", o.register_prior,
+                "With --register: weight of the maps' spatial prior (each template vertex kept "
+                "near its place in space on ZoomOut's small sizes; 0: none)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1e3))
       ->check(kFinite);

@@ -27,6 +27,22 @@ Atlas<T>::Atlas(const AtlasOptions& o) : options_(o) {
     phi_codes_ = params.add("codes.phi", o.shapes, d);
     psi_codes_ = params.add("codes.psi", o.shapes, d);
   }
+  JSA_CHECK(o.deform_nodes >= 0, "deform_nodes must be >= 0");
+  if (d > 0 && o.deform_nodes > 0) {
+    // t_k,i for every shape, one n-row block per shape; the centres c_k and
+    // the kernels' width sigma are placed once (Trainer::finish_template) and
+    // read as constants, so Adam never moves them (their gradient is zero).
+    phi_nodes_ = params.add("nodes.phi", Index(o.shapes) * o.deform_nodes, 3);
+    phi.set_nodes(params.add("nodes.centres", o.deform_nodes, 2), params.add("nodes.sigma", 1, 1));
+  }
+}
+
+template <class T>
+Var Atlas<T>::phi_nodes(Tape<T>& t, int shape) {
+  if (phi_nodes_ < 0) return Var{};
+  JSA_CHECK(shape >= 0 && shape < options_.shapes, "shape " << shape << " of " << options_.shapes);
+  const Index n = options_.deform_nodes;
+  return slice_rows(t, params.on(t, phi_nodes_), Index(shape) * n, n);
 }
 
 template <class T>
@@ -78,7 +94,8 @@ void evaluate_surface(Atlas<float>& atlas, const Block<double>& uv, Block<double
     const Index n = std::min(batch, uv.rows() - b);
     t.clear();
     Var x = t.constant(uv.middleRows(b, n).cast<float>());
-    SurfacePoints s = atlas.phi.evaluate(t, atlas.params, x, true, atlas.phi_code(t, shape));
+    SurfacePoints s = atlas.phi.evaluate(t, atlas.params, x, true, atlas.phi_code(t, shape),
+                                         atlas.phi_nodes(t, shape));
     points.middleRows(b, n) = t.value(s.points).cast<double>();
     normals.middleRows(b, n) = t.value(s.normals).cast<double>().rowwise().normalized();
     if (du) du->middleRows(b, n) = t.value(s.du).cast<double>();

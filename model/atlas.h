@@ -31,6 +31,14 @@ struct AtlasOptions {
   // two sheets that touch in 3D (an arm folded on a chest) can move apart; a
   // function of the 3D point alone must move them together. false: D(phi(x), f).
   bool deform_domain = false;
+  // Collections (beyond the paper): > 0 adds to phi_i a displacement with
+  // local support in the domain, sum_k w_k(x) t_k,i over this many normalised
+  // Gaussian kernels w_k centred in the domain (model/parametrize.h, "node
+  // displacement"). A hand folded on a chest is far from the chest in the
+  // domain, so a node can move it alone; D, a smooth function of the 3D
+  // point, cannot. The centres are placed after the template start
+  // (Trainer::finish_template); until then the term is off. 0: none.
+  int deform_nodes = 0;
 };
 
 template <class T>
@@ -47,6 +55,9 @@ class Atlas {
   // f_phi,i and f_psi,i (1 x D) of shape i on the tape; invalid Vars for a single shape.
   Var phi_code(Tape<T>& t, int shape);
   Var psi_code(Tape<T>& t, int shape);
+  // t_k,i of shape i (n x 3) on the tape: the node displacements
+  // (AtlasOptions::deform_nodes); an invalid Var without nodes.
+  Var phi_nodes(Tape<T>& t, int shape);
 
   const AtlasOptions& options() const { return options_; }
   Parameters<T> params;
@@ -57,6 +68,7 @@ class Atlas {
  private:
   AtlasOptions options_;
   int phi_codes_ = -1, psi_codes_ = -1;  // N x D parameter blocks
+  int phi_nodes_ = -1;                   // (N n) x 3: t_k,i
 };
 
 // The reconstruction (Sec. 3): phi of shape `shape` at the rows of uv (V x 2),

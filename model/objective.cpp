@@ -43,7 +43,11 @@ template <class T>
 const Block<T>& reference_points(Tape<T>& t, Atlas<T>& atlas, Var x_p, int reference) {
   const Var x_fixed = held_constant(t, x_p);
   const Var code_t = atlas.has_codes() ? held_constant(t, atlas.phi_code(t, reference)) : Var{};
-  return t.value(atlas.phi.evaluate(t, atlas.params, x_fixed, false, code_t).points);
+  const Var nodes_t = atlas.phi_nodes(t, reference);
+  return t.value(atlas.phi
+                     .evaluate(t, atlas.params, x_fixed, false, code_t,
+                               nodes_t.valid() ? held_constant(t, nodes_t) : Var{})
+                     .points);
 }
 
 // The weighted terms of L_single (Eq. 5), at most one of each kind: a fixed
@@ -85,7 +89,7 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
   Var u_s;
   if (c.chart) u_s = atlas.psi.evaluate(t, p, s6, f_psi);
   const Var phi_in = c.chart ? concat_rows(t, {x_p, u_s}) : x_p;
-  SurfacePoints all = atlas.phi.evaluate(t, p, phi_in, jacobian, f_phi);
+  SurfacePoints all = atlas.phi.evaluate(t, p, phi_in, jacobian, f_phi, atlas.phi_nodes(t, shape));
   // Diverged networks: report NaN (the trainer recovers) rather than search
   // nearest neighbours among non-finite points.
   if (!t.value(phi_in).allFinite() || !t.value(all.points).allFinite() ||
@@ -161,7 +165,9 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
     // others, moved only by its own shape's terms (which also keeps a
     // data-parallel step exact: a code's gradient stays on its shape's rank).
     const Var ref_code = held_constant(t, atlas.phi_code(t, o.metric_reference));
-    const SurfacePoints ref = atlas.phi.evaluate(t, p, x_p, true, ref_code);
+    const Var ref_nodes = atlas.phi_nodes(t, o.metric_reference);
+    const SurfacePoints ref = atlas.phi.evaluate(
+        t, p, x_p, true, ref_code, ref_nodes.valid() ? held_constant(t, ref_nodes) : Var{});
     const Var metric =
         o.metric_conformal
             ? conformal_metric_mismatch(t, first_m(all.du), first_m(all.dv), ref.du, ref.dv)

@@ -57,8 +57,20 @@ class Parametrization {
   }
   // x: M x 2 domain points. with_jacobian = false evaluates phi(x) alone.
   // code: the shape's latent code f_phi,i (1 x D) in a collection, else none.
+  // nodes: the shape's node displacements t_k,i (n x 3, Atlas::phi_nodes), or none.
   SurfacePoints evaluate(Tape<T>& t, Parameters<T>& params, Var x, bool with_jacobian,
-                         Var code = {}) const;
+                         Var code = {}, Var nodes = {}) const;
+  // The node displacement of a collection (AtlasOptions::deform_nodes):
+  //   phi_i(x) <- phi_i(x) + sum_k w_k(x) t_k,i,  w_k = g_k / sum_j g_j,
+  //   g_k(x) = exp(-|x - c_k|^2 / (2 sigma^2)),
+  // normalised kernels centred at c_k in the domain, so a node moves what the domain puts
+  // near c_k and nothing that is merely near it in 3D. `centres` (n x 2) and
+  // `sigma` (1 x 1) are parameter blocks read as constants; sigma = 0 (not
+  // yet placed) turns the term off.
+  void set_nodes(int centres, int sigma) { centres_ = centres, sigma_ = sigma; }
+  bool has_nodes() const { return centres_ >= 0; }
+  int node_centres() const { return centres_; }
+  int node_sigma() const { return sigma_; }
   const Mlp<T>& mlp() const { return mlp_; }
   T alpha() const { return alpha_; }
   bool deforms() const { return deforms_; }
@@ -68,6 +80,7 @@ class Parametrization {
   Mlp<T> deform_;  // D (deforms_ only)
   T alpha_ = T(0.01);
   bool deforms_ = false;
+  int centres_ = -1, sigma_ = -1;  // parameter blocks of the node kernels (set_nodes)
 };
 
 }  // namespace jsa

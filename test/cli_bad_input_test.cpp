@@ -116,4 +116,12 @@ TEST_CASE("cli: flag values out of range are refused before any work", "[cli]") 
   rejects(fit + "--spectral-map -1", 2, "--spectral-map");
   rejects(fit + "--spectral-map-until 1.5", 2, "--spectral-map-until");
   rejects(fit + "--spectral-map 1", 1, "--spectral-map: needs a collection");
+  // The node displacement and its registration: collections only, nodes first.
+  rejects(fit + "--deform-nodes -1", 2, "--deform-nodes");
+  rejects(fit + "--deform-nodes 64", 1, "--deform-nodes: needs a collection");
+  rejects(fit + "--nodes-width 0", 2, "--nodes-width");
+  rejects(fit + "--nodes-lr-scale -1", 2, "--nodes-lr-scale");
+  rejects(fit + "--register-prior -1", 2, "--register-prior");
+  const std::string pair = "fit builtin:sphere builtin:torus -o " + fresh_dir("flags") + "/pair ";
+  rejects(pair + "--register", 1, "--register: needs --deform-nodes > 0");
 }

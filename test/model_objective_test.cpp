@@ -467,6 +467,88 @@ TEST_CASE("objective: phi as a deformation per shape (deform_layers): gradients 
         1e-3);
 }
 
+TEST_CASE("objective: node displacement in the domain (deform_nodes): gradients and Jacobians",
+          "[objective]") {
+  // phi_i(x) + sum_k w_k(x) t_k,i, w_k = g_k / sum_j g_j with
+  // g_k(x) = exp(-|x - c_k|^2 / (2 sigma^2)):
+  // the gradients of t_k,i, of the domain's means (through x) and of the
+  // networks match central differences, the stacked tangents are the
+  // derivative of the displaced surface, and sigma = 0 turns the term off.
+  AtlasOptions ao = small_atlas_options();
+  ao.shapes = 2;
+  ao.code_size = 4;
+  ao.deform_layers = GENERATE(0, 2);
+  ao.deform_nodes = 9;
+  INFO("deform_layers " << ao.deform_layers);
+  ao.softplus_beta = 10;  // smooth, so the differences in x cross no kink
+  Atlas<double> atlas(ao);
+  Rng init(6);
+  atlas.initialize(init);
+  REQUIRE(atlas.phi.has_nodes());
+  auto centres = atlas.params.value(atlas.phi.node_centres());
+  for (int k = 0; k < 9; ++k) centres.row(k) << 0.5 * (k % 3), 0.5 * (k / 3);
+  atlas.params.value(atlas.phi.node_sigma())(0, 0) = 0.3;
+  auto nodes = atlas.params.value(atlas.params.find("nodes.phi"));
+  for (Index i = 0; i < nodes.size(); ++i) nodes.data()[i] = 0.2 * std::sin(2.0 + 1.7 * double(i));
+  const std::vector<Block<double>> targets{random_targets(32, ao.alpha, 3),
+                                           random_targets(32, ao.alpha, 4)};
+  Tape<double> tape;
+  int checked = 0;
+  const double worst = worst_over_blocks(
+      atlas, targets, {"nodes.phi", "domain.mu", "codes.phi", "phi.w0", "psi.wf"}, tape, checked);
+  INFO(checked << " entries, worst error/tolerance " << worst);
+  CHECK(checked > 40);
+  CHECK(worst <= 1.0);
+  // The centres and sigma are constants of the tape: no gradient reaches them.
+  objective_value(atlas, targets, Components{}, tape, true);
+  CHECK(atlas.params.grad(atlas.phi.node_centres()).cwiseAbs().maxCoeff() == 0.0);
+
+  Block<double> x(6, 2);
+  for (Index i = 0; i < x.size(); ++i) x.data()[i] = 0.05 + 0.17 * double(i % 7);
+  auto points = [&](const Block<double>& at, int shape, Block<double>* du, Block<double>* dv) {
+    Tape<double> t;
+    const SurfacePoints s = atlas.phi.evaluate(t, atlas.params, t.constant(at), du != nullptr,
+                                               atlas.phi_code(t, shape), atlas.phi_nodes(t, shape));
+    if (du) *du = t.value(s.du), *dv = t.value(s.dv);
+    return Block<double>(t.value(s.points));
+  };
+  double jacobian_error = 0;
+  for (int shape : {0, 1}) {
+    Block<double> du, dv;
+    const Block<double> with_tangents = points(x, shape, &du, &dv);
+    // the value rows of the stacked pass are the values-only pass
+    CHECK((with_tangents - points(x, shape, nullptr, nullptr)).cwiseAbs().maxCoeff() < 1e-12);
+    const double h = 1e-6;
+    for (int k = 0; k < 2; ++k) {
+      Block<double> xp = x, xm = x;
+      xp.col(k).array() += h;
+      xm.col(k).array() -= h;
+      const Block<double> numeric =
+          (points(xp, shape, nullptr, nullptr) - points(xm, shape, nullptr, nullptr)) / (2 * h);
+      jacobian_error =
+          std::max(jacobian_error, (numeric - (k == 0 ? du : dv)).cwiseAbs().maxCoeff());
+    }
+  }
+  CHECK(jacobian_error < 1e-6);
+  // The displacement is there (the shapes' nodes differ), and sigma = 0 removes it.
+  const Block<double> moved = points(x, 1, nullptr, nullptr);
+  atlas.params.value(atlas.phi.node_sigma())(0, 0) = 0;
+  const Block<double> still = points(x, 1, nullptr, nullptr);
+  Block<double> expected = still;
+  for (Index r = 0; r < x.rows(); ++r) {
+    double total = 0;
+    Eigen::RowVector3d moved_by = Eigen::RowVector3d::Zero();
+    for (int k = 0; k < 9; ++k) {
+      const double g = std::exp(-0.5 * (x.row(r) - centres.row(k)).squaredNorm() / 0.09);
+      total += g;
+      moved_by += g * nodes.row(9 + k);
+    }
+    expected.row(r) += moved_by / total;
+  }
+  CHECK((moved - still).cwiseAbs().maxCoeff() > 1e-2);
+  CHECK((moved - expected).cwiseAbs().maxCoeff() < 1e-12);
+}
+
 namespace {
 
 // Two shapes, phi a deformation (deform_layers) with D's output layer at its

@@ -105,9 +105,12 @@ WrapReport wrap_initialize(Atlas<float>& atlas, const std::vector<Block<float>>&
       }
       // |phi(u, v) - W(u, v)|^2 and |psi(W, alpha n_W) - (u, v)|^2, means over points.
       Var x = t.constant(uv);
-      Var phi_err =
-          sub(t, atlas.phi.evaluate(t, atlas.params, x, false, atlas.phi_code(t, shape)).points,
-              t.constant(wrap));
+      Var phi_err = sub(t,
+                        atlas.phi
+                            .evaluate(t, atlas.params, x, false, atlas.phi_code(t, shape),
+                                      atlas.phi_nodes(t, shape))
+                            .points,
+                        t.constant(wrap));
       Var psi_err = sub(
           t, atlas.psi.evaluate(t, atlas.params, t.constant(wrap6), atlas.psi_code(t, shape)), x);
       Var phi_loss = scale(t, sum(t, square(t, phi_err)), 1.0f / float(points));

@@ -51,7 +51,8 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
                 {"code_layer", o.atlas.code_layer},
                 {"softplus_beta", o.atlas.softplus_beta},
                 {"deform_layers", o.atlas.deform_layers},
-                {"deform_domain", o.atlas.deform_domain}};
+                {"deform_domain", o.atlas.deform_domain},
+                {"deform_nodes", o.atlas.deform_nodes}};
   j["weights"] = {{"surface_6d", o.weights.surface},
                   {"chart_2d", o.weights.chart},
                   {"cycle", o.weights.cycle},
@@ -107,6 +108,10 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["intrinsic_until"] = o.intrinsic_until;
   j["spectral_map"] = o.spectral_map;
   j["spectral_map_until"] = o.spectral_map_until;
+  j["register_nodes"] = o.register_nodes;
+  j["register_prior"] = o.register_prior;
+  j["nodes_lr_scale"] = o.nodes_lr_scale;
+  j["nodes_width"] = o.nodes_width;
   j["parallel_shapes"] = o.parallel_shapes;
   j["pool"] = o.pool;
   j["threads"] = o.threads;
@@ -151,6 +156,10 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
     throw InputError(what + ": atlas.deform_layers must be in [0, 64]");
   o.atlas.deform_domain = false;  // later addition: absent = D(phi(x), f)
   if (a.contains("deform_domain")) field(a, "atlas.", "deform_domain", o.atlas.deform_domain);
+  o.atlas.deform_nodes = 0;  // later addition: absent = none
+  if (a.contains("deform_nodes")) field(a, "atlas.", "deform_nodes", o.atlas.deform_nodes);
+  if (o.atlas.deform_nodes < 0 || o.atlas.deform_nodes > 4096)
+    throw InputError(what + ": atlas.deform_nodes must be in [0, 4096]");
   const json& w = j.contains("weights") ? j["weights"] : json();
   field(w, "weights.", "surface_6d", o.weights.surface);
   field(w, "weights.", "chart_2d", o.weights.chart);
@@ -254,6 +263,20 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (j.contains("spectral_map_until")) field(j, "", "spectral_map_until", o.spectral_map_until);
   if (!(o.spectral_map_until > 0 && o.spectral_map_until <= 1))
     throw InputError(what + ": spectral_map_until must be in (0, 1]");
+  o.register_nodes = false;  // later additions: absent = nodes from zero, no prior
+  if (j.contains("register_nodes")) field(j, "", "register_nodes", o.register_nodes);
+  o.register_prior = 0;
+  if (j.contains("register_prior")) field(j, "", "register_prior", o.register_prior);
+  if (!(o.register_prior >= 0) || !std::isfinite(o.register_prior))
+    throw InputError(what + ": register_prior must be >= 0");
+  o.nodes_lr_scale = 1;  // later addition: absent = one rate
+  if (j.contains("nodes_lr_scale")) field(j, "", "nodes_lr_scale", o.nodes_lr_scale);
+  if (!(o.nodes_lr_scale >= 0) || !std::isfinite(o.nodes_lr_scale))
+    throw InputError(what + ": nodes_lr_scale must be >= 0");
+  o.nodes_width = 1;  // later addition
+  if (j.contains("nodes_width")) field(j, "", "nodes_width", o.nodes_width);
+  if (!(o.nodes_width > 0) || !std::isfinite(o.nodes_width))
+    throw InputError(what + ": nodes_width must be positive");
   o.parallel_shapes = false;  // later addition: runs before it took one shape at a time
   if (j.contains("parallel_shapes")) field(j, "", "parallel_shapes", o.parallel_shapes);
   o.metric_end = -1;  // later addition: absent = a constant lambda_metric

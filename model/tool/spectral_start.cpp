@@ -30,6 +30,12 @@ SpectralStart spectral_start(const std::vector<Mesh>& meshes,
     const Block<double> vertices = frames[i].to_unit(meshes[i].vertices);
     std::vector<int> map;
     nearest(out.template_vertices, vertices, map);  // the start: nearest in space
+    if (o.prior_weight > 0) {                       // a template vertex stays near its own place
+      zo.prior_weight = o.prior_weight;
+      zo.prior_until = o.prior_until;
+      zo.prior_on_target = out.template_vertices;
+      zo.prior_on_source = vertices;
+    }
     // ZoomOut's target is the template (the map is defined on its vertices).
     map = zoomout(laplace_basis(meshes[i], o.functions), on_t, map, zo);
     out.images[i].resize(Index(map.size()), 3);

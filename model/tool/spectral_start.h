@@ -18,6 +18,10 @@ struct SpectralStartOptions {
   int k_start = 6;     // ZoomOut's first size
   int k_step = 4;
   int samples = 3000;  // ZoomOut's vertices per shape before its last size
+  // ZoomOut's spatial prior on its sizes below prior_until, anchored on each
+  // template vertex's own position (ZoomOutOptions::prior_weight; 0: none).
+  double prior_weight = 0;
+  int prior_until = 20;
 };
 
 struct SpectralStart {

@@ -60,6 +60,7 @@ static void validate(const FitOptions& o) {
   require(o.intrinsic_until >= 0 && o.intrinsic_until <= 1, "intrinsic_until must be in [0, 1]");
   require(o.spectral_map >= 0 && std::isfinite(o.spectral_map),
           "spectral_map must be >= 0 and finite");
+  require(o.nodes_width > 0 && std::isfinite(o.nodes_width), "nodes_width must be positive");
   require(o.spectral_map_until > 0 && o.spectral_map_until <= 1,
           "spectral_map_until must be in (0, 1]");
   require(o.surface_lr_scale >= 0 && std::isfinite(o.surface_lr_scale),
@@ -363,6 +364,18 @@ void Trainer::finish_template() {
           for (Index c = 0; c < e.cols; ++c) block[r * e.cols + c] = block[t * e.cols + c];
     }
   }
+  if (atlas_->phi.has_nodes()) {
+    // The node displacement starts here (model/tool/node_placement.h): its
+    // centres on the template's surface, and with a registration
+    // (set_spectral_map) each shape's t_k,i fitted to it; Adam's moments of
+    // the nodes are still zero (the term was off in the template start).
+    NodePlacementOptions np;
+    np.seed = options_.seed;
+    np.width = options_.nodes_width;
+    const Block<float>* vertices = map_surface_ ? &map_surface_->points() : nullptr;
+    node_report_ = place_nodes(*atlas_, options_.template_shape, vertices,
+                               vertices ? &map_images_ : nullptr, np);
+  }
   take_snapshot(rng_.state());  // a fault in the joint run must not undo the copy
 }
 
@@ -572,6 +585,8 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
   if (options_.code_lr_scale != 1 && atlas_->has_codes())
     for (const char* name : {"codes.phi", "codes.psi"})
       hold(atlas_->params.find(name), options_.code_lr_scale);
+  if (options_.nodes_lr_scale != 1 && atlas_->phi.has_nodes())
+    hold(atlas_->params.find("nodes.phi"), options_.nodes_lr_scale);
   if (options_.surface_lr_scale != 1 && !template_step && atlas_->phi.deforms())
     for (int i = 0; i < atlas_->params.count(); ++i) {
       const std::string& name = atlas_->params.entry(i).name;

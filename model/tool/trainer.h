@@ -17,6 +17,7 @@
 #include "engine/gemm.h"
 #include "model/heuristics/wrap.h"
 #include "model/objective.h"
+#include "model/tool/node_placement.h"
 #include "model/tool/schedule.h"
 #include "model/tool/team.h"
 
@@ -170,6 +171,23 @@ struct FitOptions {
   // iterations. 0: off.
   double spectral_map = 0;
   double spectral_map_until = 0.5;
+  // Collections with atlas.deform_nodes: fit the nodes after the template
+  // start to a registration of the template to each shape (the spectral maps
+  // of model/tool/spectral_start.h; model/tool/node_placement.h), so the maps
+  // decide the correspondence and the training refines it. false: the nodes
+  // start at zero.
+  bool register_nodes = false;
+  // ... the maps' spatial prior (ZoomOutOptions::prior_weight, on ZoomOut's
+  // sizes below 20): each template vertex is kept near where it is in space, so
+  // an intrinsic symmetry (an ant's left and right legs) is settled by the
+  // pose. 0: none.
+  double register_prior = 0;
+  // Collections with atlas.deform_nodes: the node displacements' learning
+  // rate as a multiple of the rest's (0: the registration's start stays fixed).
+  double nodes_lr_scale = 1;
+  // ... and the kernels' width sigma as a multiple of the centres' spacing in
+  // the domain (NodePlacementOptions::width): wider kernels, a smoother field.
+  double nodes_width = 1;
   // Collections: lambda_metric moves from weights.metric at the first joint
   // step to this value at the first learning-rate decay (geometrically;
   // model/tool/schedule.h, scheduled_weight), then stays. < 0: constant.
@@ -385,6 +403,10 @@ class Trainer {
   // them on that shape, in its unit frame (V_t x 3; the template's own: empty).
   void set_spectral_map(const Block<double>& template_vertices,
                         const std::vector<Block<double>>& images);
+  // With AtlasOptions::deform_nodes: how the nodes were placed after the
+  // template start (empty before it). The data of set_spectral_map, when set,
+  // is the registration their displacements are fitted to.
+  const NodePlacementReport& node_report() const { return node_report_; }
   double learning_rate() const;  // the schedule at the current iteration, times the fault scale
   // M at the current iteration (the schedule's ramp). The template start runs
   // before iteration 0, so its steps take the ramp's first M.
@@ -450,6 +472,7 @@ class Trainer {
   // L_map (FitOptions::spectral_map): the template's vertices, their images.
   std::unique_ptr<NearestIndex<float>> map_surface_;
   std::vector<Block<float>> map_images_;
+  NodePlacementReport node_report_;  // where finish_template put the nodes
   Team* team_ = nullptr;
   int first_shape_ = 0, last_shape_ = 0;  // this rank's block of shapes
   std::vector<std::pair<size_t, size_t>>
