@@ -82,6 +82,37 @@ double worst_over_blocks(Atlas<double>& atlas, const std::vector<Block<double>>&
   return worst;
 }
 
+// phi_i at the rows of `at` (shape i's code and nodes); with du, dv also the
+// Jacobian's columns from the stacked tangent rows.
+Block<double> surface_at(Atlas<double>& atlas, const Block<double>& at, int shape,
+                         Block<double>* du = nullptr, Block<double>* dv = nullptr) {
+  Tape<double> t;
+  const SurfacePoints s = atlas.phi.evaluate(t, atlas.params, t.constant(at), du != nullptr,
+                                             atlas.phi_code(t, shape), atlas.phi_nodes(t, shape));
+  if (du) *du = t.value(s.du), *dv = t.value(s.dv);
+  return Block<double>(t.value(s.points));
+}
+
+// The worst |central difference in u, v - tangent row| of phi_i at x, over
+// shapes 0 and 1.
+double worst_jacobian_error(Atlas<double>& atlas, const Block<double>& x) {
+  double worst = 0;
+  for (int shape : {0, 1}) {
+    Block<double> du, dv;
+    surface_at(atlas, x, shape, &du, &dv);
+    const double h = 1e-6;
+    for (int k = 0; k < 2; ++k) {
+      Block<double> xp = x, xm = x;
+      xp.col(k).array() += h;
+      xm.col(k).array() -= h;
+      const Block<double> numeric =
+          (surface_at(atlas, xp, shape) - surface_at(atlas, xm, shape)) / (2 * h);
+      worst = std::max(worst, (numeric - (k == 0 ? du : dv)).cwiseAbs().maxCoeff());
+    }
+  }
+  return worst;
+}
+
 }  // namespace
 
 TEST_CASE("objective: gradients of L_single match central differences", "[objective]") {
@@ -440,31 +471,8 @@ TEST_CASE("objective: phi as a deformation per shape (deform_layers): gradients 
   // shapes differ (D takes the code).
   Block<double> x(5, 2);
   for (Index i = 0; i < x.size(); ++i) x.data()[i] = 0.1 + 0.15 * double(i % 7);
-  auto points = [&](const Block<double>& at, int shape, Block<double>* du, Block<double>* dv) {
-    Tape<double> t;
-    const SurfacePoints s = atlas.phi.evaluate(t, atlas.params, t.constant(at), du != nullptr,
-                                               atlas.phi_code(t, shape));
-    if (du) *du = t.value(s.du), *dv = t.value(s.dv);
-    return Block<double>(t.value(s.points));
-  };
-  double jacobian_error = 0;
-  for (int shape : {0, 1}) {
-    Block<double> du, dv;
-    points(x, shape, &du, &dv);
-    const double h = 1e-6;
-    for (int k = 0; k < 2; ++k) {
-      Block<double> xp = x, xm = x;
-      xp.col(k).array() += h;
-      xm.col(k).array() -= h;
-      const Block<double> numeric =
-          (points(xp, shape, nullptr, nullptr) - points(xm, shape, nullptr, nullptr)) / (2 * h);
-      jacobian_error =
-          std::max(jacobian_error, (numeric - (k == 0 ? du : dv)).cwiseAbs().maxCoeff());
-    }
-  }
-  CHECK(jacobian_error < 1e-6);
-  CHECK((points(x, 0, nullptr, nullptr) - points(x, 1, nullptr, nullptr)).cwiseAbs().maxCoeff() >
-        1e-3);
+  CHECK(worst_jacobian_error(atlas, x) < 1e-6);
+  CHECK((surface_at(atlas, x, 0) - surface_at(atlas, x, 1)).cwiseAbs().maxCoeff() > 1e-3);
 }
 
 TEST_CASE("objective: node displacement in the domain (deform_nodes): gradients and Jacobians",
@@ -505,35 +513,17 @@ TEST_CASE("objective: node displacement in the domain (deform_nodes): gradients 
 
   Block<double> x(6, 2);
   for (Index i = 0; i < x.size(); ++i) x.data()[i] = 0.05 + 0.17 * double(i % 7);
-  auto points = [&](const Block<double>& at, int shape, Block<double>* du, Block<double>* dv) {
-    Tape<double> t;
-    const SurfacePoints s = atlas.phi.evaluate(t, atlas.params, t.constant(at), du != nullptr,
-                                               atlas.phi_code(t, shape), atlas.phi_nodes(t, shape));
-    if (du) *du = t.value(s.du), *dv = t.value(s.dv);
-    return Block<double>(t.value(s.points));
-  };
-  double jacobian_error = 0;
   for (int shape : {0, 1}) {
-    Block<double> du, dv;
-    const Block<double> with_tangents = points(x, shape, &du, &dv);
     // the value rows of the stacked pass are the values-only pass
-    CHECK((with_tangents - points(x, shape, nullptr, nullptr)).cwiseAbs().maxCoeff() < 1e-12);
-    const double h = 1e-6;
-    for (int k = 0; k < 2; ++k) {
-      Block<double> xp = x, xm = x;
-      xp.col(k).array() += h;
-      xm.col(k).array() -= h;
-      const Block<double> numeric =
-          (points(xp, shape, nullptr, nullptr) - points(xm, shape, nullptr, nullptr)) / (2 * h);
-      jacobian_error =
-          std::max(jacobian_error, (numeric - (k == 0 ? du : dv)).cwiseAbs().maxCoeff());
-    }
+    Block<double> du, dv;
+    const Block<double> with_tangents = surface_at(atlas, x, shape, &du, &dv);
+    CHECK((with_tangents - surface_at(atlas, x, shape)).cwiseAbs().maxCoeff() < 1e-12);
   }
-  CHECK(jacobian_error < 1e-6);
+  CHECK(worst_jacobian_error(atlas, x) < 1e-6);
   // The displacement is there (the shapes' nodes differ), and sigma = 0 removes it.
-  const Block<double> moved = points(x, 1, nullptr, nullptr);
+  const Block<double> moved = surface_at(atlas, x, 1);
   atlas.params.value(atlas.phi.node_sigma())(0, 0) = 0;
-  const Block<double> still = points(x, 1, nullptr, nullptr);
+  const Block<double> still = surface_at(atlas, x, 1);
   Block<double> expected = still;
   for (Index r = 0; r < x.rows(); ++r) {
     double total = 0;
