@@ -278,6 +278,12 @@ void run_fit(FitArgs& a, Team& team) {
       throw InputError("--deform-nodes: needs a collection (two or more inputs)");
     if (o.register_nodes && o.atlas.deform_nodes == 0)
       throw InputError("--register: needs --deform-nodes > 0");
+    // The nodes are placed when the template start ends (Trainer::finish_template).
+    if (o.atlas.deform_nodes > 0 &&
+        !(o.template_steps > 0 || (o.template_steps < 0 && o.template_share > 0)))
+      throw InputError(
+          "--deform-nodes: needs the template start (--template-steps > 0, or -1 "
+          "with --template-share > 0)");
     if (o.atlas.deform_domain && (inputs.size() < 2 || o.atlas.deform_layers == 0))
       throw InputError(
           "--deform-domain: needs a collection (two or more inputs) with --deform-layers > 0");

@@ -89,6 +89,9 @@ void Trainer::require_rank_support(const FitOptions& o, int shapes, int ranks) {
     throw InputError("template_steps is not supported with more than one MPI rank");
   if (ranks > 1 && o.template_shape != 0)
     throw InputError("template_shape other than 0 is not supported with more than one MPI rank");
+  // The nodes are placed after the template start, which a data-parallel run has not.
+  if (ranks > 1 && o.atlas.deform_nodes > 0)
+    throw InputError("deform_nodes is not supported with more than one MPI rank");
 }
 
 Trainer::Trainer(const FitOptions& o, const std::vector<Block<double>>& pools, Team* team)
