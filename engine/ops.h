@@ -9,6 +9,8 @@
 //                       sqrt, exp, log
 //   ops_rows.cpp        concat/slice of columns and rows, gather rows by index
 //   ops_reduce.cpp      sum, mean, row_dot, row_norm, row_normalize, cross3
+//   ops_kernels.cpp     gaussian_weights_stacked: normalised Gaussian kernels
+//                       in the plane, with their tangent rows
 // Shapes use one alphabet: N rows (points), C columns (channels).
 // A new op with its own kernel uses the custom-op hook Tape::node/on_backward.
 #pragma once
@@ -101,5 +103,14 @@ template <class T>
 Var row_normalize(Tape<T>& t, Var x, T eps = T(1e-12));
 template <class T>
 Var cross3(Tape<T>& t, Var a, Var b);  // N x 3: a_i x b_i
+
+// ---- kernels (ops_kernels.cpp) ----
+// The normalised Gaussian weights of n centres in the plane (a partition of
+// unity): x: N x 2 stacked rows [x; dx_1; ...] with m value rows (m < 0: all
+// rows are values), centres: n x 2 (constants), sigma > 0. Returns N x n:
+//   w_k(x) = g_k(x) / sum_l g_l(x),  g_k(x) = exp(-|x - c_k|^2 / (2 sigma^2))
+// on the value rows and dw_k = grad w_k . dx on the tangent rows.
+template <class T>
+Var gaussian_weights_stacked(Tape<T>& t, Var x, Index m, const Block<T>& centres, T sigma);
 
 }  // namespace jsa

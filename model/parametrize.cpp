@@ -1,7 +1,5 @@
 #include "model/parametrize.h"
 
-#include <vector>
-
 #include "engine/ops.h"
 #include "engine/tangents.h"
 
@@ -13,38 +11,13 @@ namespace {
 // values only), with the normalised kernels (a partition of unity, so a
 // field the t_k share, a shift, is reproduced exactly wherever x lies)
 //   w_k(x) = g_k(x) / sum_j g_j(x),   g_k(x) = exp(-|x - c_k|^2 / (2 sigma^2)).
-// Tangent rows by the chain rule: dg_k = g_k (c_k - x) . dx / sigma^2 and
-// dw_k = (dg_k - w_k sum_j dg_j) / sum_j g_j, so the Jacobian of the
-// displacement comes out of the same pass as phi's (Eq. 1). Built from the
-// op library, whose ops are each gradient-checked.
+// The tangent rows carry dw_k = grad w_k . dx, so the Jacobian of the
+// displacement comes out of the same pass as phi's (Eq. 1): one kernel op
+// (engine/ops_kernels.cpp), then one GEMM with the displacements t_k.
 template <class T>
 Var node_displacement(Tape<T>& t, Var x_rows, Index m, const Block<T>& centres, T sigma,
                       Var displacements) {
-  const Index rows = t.rows(x_rows);
-  const Index value_rows = m < 0 ? rows : m;
-  const Var xv = m < 0 ? x_rows : slice_rows(t, x_rows, 0, m);
-  const Var c_t = t.constant(centres.transpose());                           // 2 x n
-  const Var c_sq = t.constant(centres.rowwise().squaredNorm().transpose());  // 1 x n
-  // -|x - c_k|^2 / (2 sigma^2), with |x - c_k|^2 = |x|^2 - 2 x.c_k + |c_k|^2
-  const Var r2 =
-      add(t, add(t, scale(t, linear(t, xv, c_t, Var{}), T(-2)), c_sq), row_sum(t, square(t, xv)));
-  const Var a = scale(t, r2, T(-0.5) / (sigma * sigma));
-  // w is unchanged by a shift of a's row: shifted by its largest entry, no
-  // row underflows (sum_j g_j >= 1), and the shift is a constant.
-  const Block<T> row_max = t.value(a).rowwise().maxCoeff();
-  const Var g = exp(t, sub(t, a, t.constant(row_max)));            // m x n
-  const Var inv = exp(t, scale(t, log(t, row_sum(t, g)), T(-1)));  // 1 / sum_j g_j, m x 1
-  const Var w = mul(t, g, inv);
-  if (m < 0) return linear(t, w, displacements, Var{});
-  const Index blocks = rows / value_rows - 1;  // the tangent blocks
-  auto repeat = [&](Var v) { return concat_rows(t, std::vector<Var>(size_t(blocks), v)); };
-  const Var dx = slice_rows(t, x_rows, value_rows, rows - value_rows);
-  // (c_k - x) . dx = dx.c_k - dx.x
-  const Var along = sub(t, linear(t, dx, c_t, Var{}), row_dot(t, dx, repeat(xv)));
-  const Var dg = mul(t, repeat(g), scale(t, along, T(1) / (sigma * sigma)));
-  const Var w_rep = repeat(w);
-  const Var dw = mul(t, sub(t, dg, mul(t, w_rep, row_sum(t, dg))), repeat(inv));
-  return linear(t, concat_rows(t, {w, dw}), displacements, Var{});
+  return linear(t, gaussian_weights_stacked(t, x_rows, m, centres, sigma), displacements, Var{});
 }
 
 }  // namespace

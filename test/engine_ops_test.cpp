@@ -132,6 +132,20 @@ std::vector<GradCase> op_cases() {
            {signed_block(rng, n, 3), signed_block(rng, n, 3)});
   add_case("stack_tangents", [](T& t, const Vs& x) { return stack_tangents(t, x[0]); },
            {signed_block(rng, n, 3)});
+  // Six centres over the points' square and sigma = 0.6: every weight between
+  // about 1e-3 and 0.9, so each kernel and the normalisation matter; the
+  // tangent rows are arbitrary directions, not only e_u and e_v.
+  const Block<double> centres = uniform_block(rng, 6, 2, -1.0, 1.0);
+  add_case("gaussian_weights_stacked (3 blocks)",
+           [n, centres](T& t, const Vs& x) {
+             return gaussian_weights_stacked(t, x[0], n, centres, 0.6);
+           },
+           {signed_block(rng, 3 * n, 2)});
+  add_case("gaussian_weights_stacked (plain rows)",
+           [centres](T& t, const Vs& x) {
+             return gaussian_weights_stacked(t, x[0], Index(-1), centres, 0.6);
+           },
+           {signed_block(rng, n, 2)});
   return cases;
 }
 
