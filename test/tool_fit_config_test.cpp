@@ -215,17 +215,17 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   d.register_nodes = true;
   d.register_prior = 0.3;
   d.nodes_lr_scale = 0.5;
-  d.nodes_width = 2;
+  d.nodes_width = 1.5;
   const jsa::FitOptions nodes = jsa::fit_options_from_json(jsa::fit_options_to_json(d), "x");
   CHECK(nodes.atlas.deform_nodes == 128);
   CHECK(nodes.register_nodes);
   CHECK(nodes.register_prior == 0.3);
   CHECK(nodes.nodes_lr_scale == 0.5);
-  CHECK(nodes.nodes_width == 2);
+  CHECK(nodes.nodes_width == 1.5);
   std::string before_nodes = jsa::fit_options_to_json(d, -1);
   for (const std::string key :
        {",\"deform_nodes\":128", ",\"register_nodes\":true", ",\"register_prior\":0.3",
-        ",\"nodes_lr_scale\":0.5", ",\"nodes_width\":2.0"}) {
+        ",\"nodes_lr_scale\":0.5", ",\"nodes_width\":1.5"}) {
     const auto at = before_nodes.find(key);
     INFO(key);
     REQUIRE(at != std::string::npos);
@@ -238,13 +238,14 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   CHECK(no_nodes.nodes_lr_scale == 1);
   CHECK(no_nodes.nodes_width == 1);
   std::string zero_width = jsa::fit_options_to_json(d, -1);
-  zero_width.replace(zero_width.find(",\"nodes_width\":2.0"), 17, ",\"nodes_width\":0.0");
+  const std::string width_key = ",\"nodes_width\":1.5";
+  zero_width.replace(zero_width.find(width_key), width_key.size(), ",\"nodes_width\":0.0");
   CHECK_THROWS(jsa::fit_options_from_json(zero_width, "zero width"));
   d.atlas.deform_nodes = 0;
   d.register_nodes = false;
   d.register_prior = 0;
   d.nodes_lr_scale = 1;
-  d.nodes_width = 1;
+  d.nodes_width = jsa::FitOptions{}.nodes_width;
   // L_6D^h's weight and its stage: kept when set, off (and the whole run) when absent.
   d.intrinsic = 0.25;
   d.intrinsic_until = 0.5;

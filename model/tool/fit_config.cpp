@@ -273,7 +273,7 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (j.contains("nodes_lr_scale")) field(j, "", "nodes_lr_scale", o.nodes_lr_scale);
   if (!(o.nodes_lr_scale >= 0) || !std::isfinite(o.nodes_lr_scale))
     throw InputError(what + ": nodes_lr_scale must be >= 0");
-  o.nodes_width = 1;  // later addition
+  o.nodes_width = 1;  // later addition: absent = the width before the default became 2
   if (j.contains("nodes_width")) field(j, "", "nodes_width", o.nodes_width);
   if (!(o.nodes_width > 0) || !std::isfinite(o.nodes_width))
     throw InputError(what + ": nodes_width must be positive");

@@ -17,7 +17,7 @@ namespace jsa {
 
 struct NodePlacementOptions {
   int samples = 20000;  // domain points drawn from P to place and fit the nodes
-  double width = 1.0;   // sigma as a multiple of the centres' mean spacing in the domain
+  double width = 2.0;   // sigma as a multiple of the centres' mean spacing in the domain
   double ridge = 1e-4;  // Tikhonov weight, relative to the mean diagonal of G^T G
   uint64_t seed = 1;
 };

@@ -187,7 +187,9 @@ struct FitOptions {
   double nodes_lr_scale = 1;
   // ... and the kernels' width sigma as a multiple of the centres' spacing in
   // the domain (NodePlacementOptions::width): wider kernels, a smoother field.
-  double nodes_width = 1;
+  // 2 carried the registration best (1, 3 and 4 behind; docs/collections.md,
+  // twenty-first round).
+  double nodes_width = 2;
   // Collections: lambda_metric moves from weights.metric at the first joint
   // step to this value at the first learning-rate decay (geometrically;
   // model/tool/schedule.h, scheduled_weight), then stays. < 0: constant.
