@@ -16,6 +16,7 @@
 #include <iostream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -32,6 +33,7 @@
 #include "model/tool/pose_by_fit.h"
 #include "model/tool/shape_input.h"
 #include "model/tool/spectral_start.h"
+#include "model/tool/template_coverage.h"
 
 namespace jsa::cli {
 namespace {
@@ -120,6 +122,7 @@ auto with_flag_names(F&& f) {
       {"spectral_map", "--spectral-map"},
       {"spectral_map_until", "--spectral-map-until"},
       {"register_prior", "--register-prior"},
+      {"template_coverage", "--template-coverage"},
       {"nodes_lr_scale", "--nodes-lr-scale"},
       {"nodes_width", "--nodes-width"},
       {"atlas.deform_nodes", "--deform-nodes"},
@@ -139,6 +142,13 @@ auto with_flag_names(F&& f) {
         throw InputError(std::string(flag) + m.substr(std::strlen(setting)));
     throw;
   }
+}
+
+// The maps of L_map and --register (model/tool/spectral_start.h).
+SpectralStartOptions registration_options(const FitOptions& o) {
+  SpectralStartOptions so;
+  so.prior_weight = o.register_prior;
+  return so;
 }
 
 Trainer make_trainer(const FitOptions& o, const std::vector<Block<double>>& pools, Team* team) {
@@ -278,6 +288,10 @@ void run_fit(FitArgs& a, Team& team) {
       throw InputError("--deform-nodes: needs a collection (two or more inputs)");
     if (o.register_nodes && o.atlas.deform_nodes == 0)
       throw InputError("--register: needs --deform-nodes > 0");
+    if (o.template_coverage && (inputs.size() < 2 || o.template_shape >= 0))
+      throw InputError(
+          "--template-coverage: chooses the template of a collection (two or more inputs, "
+          "without --template-shape)");
     // The nodes are placed when the template start ends (Trainer::finish_template).
     if (o.atlas.deform_nodes > 0 &&
         !(o.template_steps > 0 || (o.template_steps < 0 && o.template_share > 0)))
@@ -501,9 +515,31 @@ void run_fit(FitArgs& a, Team& team) {
   // The template (FitOptions::template_shape): -1 asks for the medoid of the
   // aligned pools (model/tool/shape_input.h). A data-parallel run has no
   // template start and keeps shape 0 as L_metric's reference.
+  // With --template-coverage (meshes) the candidates are scored instead by how
+  // well their spectral registrations cover the others
+  // (model/tool/template_coverage.h); with --register the winner's maps are
+  // the registration.
+  std::optional<SpectralStart> registration;
   if (!resuming && o.template_shape < 0) {
     o.template_shape = 0;
-    if (!many && inputs.size() > 1) {
+    if (!many && inputs.size() > 1 && o.template_coverage) {
+      const auto s0 = std::chrono::steady_clock::now();
+      std::vector<Mesh> meshes;
+      for (const RunInput& s : shapes) meshes.push_back(s.mesh);
+      CoverageChoice c = template_by_coverage(meshes, frames, pools, registration_options(o));
+      o.template_shape = c.shape;
+      if (o.register_nodes || o.spectral_map > 0) registration = std::move(c.start);
+      const double coverage_seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();
+      pose_fit_seconds += coverage_seconds;  // counted against --minutes, as the pose step
+      if (!a.quiet) {
+        std::cerr << "fit: template shape " << c.shape << " (" << inputs[size_t(c.shape)]
+                  << "), whose registration covers the others best (in "
+                  << format_duration(coverage_seconds) << "); distances summed:";
+        for (double v : c.sums) std::fprintf(stderr, " %.4g", v);
+        std::cerr << "\n";
+      }
+    } else if (!many && inputs.size() > 1) {
       const MedoidChoice m = medoid_shape(pools);
       o.template_shape = m.shape;
       if (!a.quiet) {
@@ -526,12 +562,12 @@ void run_fit(FitArgs& a, Team& team) {
       throw InputError(o.spectral_map > 0 ? "--spectral-map: not over MPI yet"
                                           : "--register: not over MPI yet");
     const auto s0 = std::chrono::steady_clock::now();
-    std::vector<Mesh> meshes;
-    for (const RunInput& s : shapes) meshes.push_back(s.mesh);
-    SpectralStartOptions so;
-    so.prior_weight = o.register_prior;
-    const SpectralStart start = spectral_start(meshes, frames, o.template_shape, so);
-    trainer.set_spectral_map(start.template_vertices, start.images);
+    if (!registration) {
+      std::vector<Mesh> meshes;
+      for (const RunInput& s : shapes) meshes.push_back(s.mesh);
+      registration = spectral_start(meshes, frames, o.template_shape, registration_options(o));
+    }
+    trainer.set_spectral_map(registration->template_vertices, registration->images);
     const double took =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();
     pose_fit_seconds += took;  // counted against --minutes, as the pose step
@@ -1202,6 +1238,10 @@ void add_fit(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0.1, 100.0))
       ->check(kFinite);
+  c->add_flag("--template-coverage", o.template_coverage,
+              "Collections of meshes, with --template-shape -1: take as the template the shape "
+              "whose spectral registration covers the others best instead of the medoid (one "
+              "ZoomOut per ordered pair of shapes; the time counts against --minutes)");
   c->add_option("--register-prior", o.register_prior,
                 "With --register: weight of the maps' spatial prior (each template vertex kept "
                 "near its place in space on ZoomOut's small sizes; 0: none)")

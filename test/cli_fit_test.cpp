@@ -505,3 +505,30 @@ TEST_CASE(
     CHECK(cached.output.find("from the cache " + cache) != std::string::npos);
   }
 }
+
+TEST_CASE("cli: --template-coverage takes the template whose registration covers the others",
+          "[cli]") {
+  const std::string dir = fresh_dir("register_template");
+  const std::string small =
+      " -K 200 -M 200 --width 16 --depth 2 --threads 1 --pool 5000 --mesh-resolution 32";
+  const Result r = run("fit builtin:capsule builtin:sphere builtin:capsule -o " + dir +
+                       " --template-steps 3 --iters 2 --code-size 8 --deform-nodes 16 --register "
+                       "--template-coverage" +
+                       small);
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  const std::string said = "), whose registration covers the others best";
+  const auto at = r.output.find(said);
+  REQUIRE(at != std::string::npos);
+  CHECK(r.output.find("the medoid") == std::string::npos);
+  // "fit: template shape I (FILE), whose ...": the shape said is the one saved.
+  const auto line = r.output.rfind("fit: template shape ", at);
+  REQUIRE(line != std::string::npos);
+  const int said_shape = std::stoi(r.output.substr(line + 20));
+  const std::string config = read_text(dir + "/config.json");
+  const auto saved = config.find("\"template_shape\": ");
+  REQUIRE(saved != std::string::npos);
+  CHECK(std::stoi(config.substr(saved + 18)) == said_shape);
+  CHECK(r.output.find("spectral maps from the template (shape " + std::to_string(said_shape)) !=
+        std::string::npos);
+}

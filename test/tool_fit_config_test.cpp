@@ -216,16 +216,18 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   d.register_prior = 0.3;
   d.nodes_lr_scale = 0.5;
   d.nodes_width = 1.5;
+  d.template_coverage = true;
   const jsa::FitOptions nodes = jsa::fit_options_from_json(jsa::fit_options_to_json(d), "x");
   CHECK(nodes.atlas.deform_nodes == 128);
   CHECK(nodes.register_nodes);
   CHECK(nodes.register_prior == 0.3);
   CHECK(nodes.nodes_lr_scale == 0.5);
   CHECK(nodes.nodes_width == 1.5);
+  CHECK(nodes.template_coverage);
   std::string before_nodes = jsa::fit_options_to_json(d, -1);
   for (const std::string key :
        {",\"deform_nodes\":128", ",\"register_nodes\":true", ",\"register_prior\":0.3",
-        ",\"nodes_lr_scale\":0.5", ",\"nodes_width\":1.5"}) {
+        ",\"nodes_lr_scale\":0.5", ",\"nodes_width\":1.5", ",\"template_coverage\":true"}) {
     const auto at = before_nodes.find(key);
     INFO(key);
     REQUIRE(at != std::string::npos);
@@ -237,12 +239,14 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   CHECK(no_nodes.register_prior == 0);
   CHECK(no_nodes.nodes_lr_scale == 1);
   CHECK(no_nodes.nodes_width == 1);
+  CHECK(!no_nodes.template_coverage);
   std::string zero_width = jsa::fit_options_to_json(d, -1);
   const std::string width_key = ",\"nodes_width\":1.5";
   zero_width.replace(zero_width.find(width_key), width_key.size(), ",\"nodes_width\":0.0");
   CHECK_THROWS(jsa::fit_options_from_json(zero_width, "zero width"));
   d.atlas.deform_nodes = 0;
   d.register_nodes = false;
+  d.template_coverage = false;
   d.register_prior = 0;
   d.nodes_lr_scale = 1;
   d.nodes_width = jsa::FitOptions{}.nodes_width;

@@ -108,6 +108,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["intrinsic_until"] = o.intrinsic_until;
   j["spectral_map"] = o.spectral_map;
   j["spectral_map_until"] = o.spectral_map_until;
+  j["template_coverage"] = o.template_coverage;
   j["register_nodes"] = o.register_nodes;
   j["register_prior"] = o.register_prior;
   j["nodes_lr_scale"] = o.nodes_lr_scale;
@@ -263,6 +264,8 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (j.contains("spectral_map_until")) field(j, "", "spectral_map_until", o.spectral_map_until);
   if (!(o.spectral_map_until > 0 && o.spectral_map_until <= 1))
     throw InputError(what + ": spectral_map_until must be in (0, 1]");
+  o.template_coverage = false;  // later addition: absent = the medoid
+  if (j.contains("template_coverage")) field(j, "", "template_coverage", o.template_coverage);
   o.register_nodes = false;  // later additions: absent = nodes from zero, no prior
   if (j.contains("register_nodes")) field(j, "", "register_nodes", o.register_nodes);
   o.register_prior = 0;

@@ -7,17 +7,24 @@ namespace jsa {
 
 SpectralStart spectral_start(const std::vector<Mesh>& meshes,
                              const std::vector<Normalization>& frames, int reference,
-                             const SpectralStartOptions& o) {
+                             const SpectralStartOptions& o,
+                             const std::vector<LaplaceBasis>* bases) {
   const size_t n = meshes.size();
   JSA_CHECK(frames.size() == n && reference >= 0 && size_t(reference) < n,
             "spectral_start: one frame per mesh, and a reference among them");
+  JSA_CHECK(!bases || bases->size() == n, "spectral_start: one basis per mesh");
   for (const Mesh& m : meshes)
     if (m.is_point_cloud())
       throw InputError("--spectral-map needs triangle meshes (an input is a point cloud)");
   SpectralStart out;
   const Mesh& t = meshes[size_t(reference)];
   out.template_vertices = frames[size_t(reference)].to_unit(t.vertices);
-  const LaplaceBasis on_t = laplace_basis(t, o.functions);
+  std::vector<LaplaceBasis> own;
+  if (!bases) {
+    for (const Mesh& m : meshes) own.push_back(laplace_basis(m, o.functions));
+    bases = &own;
+  }
+  const LaplaceBasis& on_t = (*bases)[size_t(reference)];
   ZoomOutOptions zo;
   zo.k_start = o.k_start;
   zo.k_end = o.functions;
@@ -37,7 +44,7 @@ SpectralStart spectral_start(const std::vector<Mesh>& meshes,
       zo.prior_on_source = vertices;
     }
     // ZoomOut's target is the template (the map is defined on its vertices).
-    map = zoomout(laplace_basis(meshes[i], o.functions), on_t, map, zo);
+    map = zoomout((*bases)[i], on_t, map, zo);
     out.images[i].resize(Index(map.size()), 3);
     for (size_t v = 0; v < map.size(); ++v) out.images[i].row(Index(v)) = vertices.row(map[v]);
   }

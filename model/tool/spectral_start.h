@@ -30,9 +30,12 @@ struct SpectralStart {
 };
 
 // meshes in their input frames, frames the unit frames of the fit (with the
-// pose step's rotations). Throws InputError for a point cloud.
+// pose step's rotations). Throws InputError for a point cloud. bases: each
+// mesh's laplace_basis(mesh, o.functions), when the caller has them already
+// (nullptr: computed here).
 SpectralStart spectral_start(const std::vector<Mesh>& meshes,
                              const std::vector<Normalization>& frames, int reference,
-                             const SpectralStartOptions& o = {});
+                             const SpectralStartOptions& o = {},
+                             const std::vector<LaplaceBasis>* bases = nullptr);
 
 }  // namespace jsa

@@ -128,6 +128,9 @@ struct FitOptions {
   // reference. `jsatlas fit --template-shape -1` picks the medoid
   // (model/tool/shape_input.h) and stores its index here.
   int template_shape = 0;
+  // ... with -1 and meshes: pick instead the shape whose spectral registration
+  // covers the others best (model/tool/template_coverage.h).
+  bool template_coverage = false;
   // Collections: turn the first shape onto its principal axes and every other
   // into its pose before fitting (io/geometry/rigid_align.h, applied by the
   // caller: model/tool/shape_input.h).
