@@ -126,6 +126,8 @@ auto with_flag_names(F&& f) {
       {"nodes_lr_scale", "--nodes-lr-scale"},
       {"nodes_width", "--nodes-width"},
       {"atlas.deform_nodes", "--deform-nodes"},
+      {"atlas.fine_nodes", "--fine-nodes"},
+      {"fine_width", "--fine-width"},
       {"schedule.kind", "--schedule"},
       {"schedule.points_start", "--points-start"},
       {"schedule.ramp_until", "--ramp-until"},
@@ -286,6 +288,8 @@ void run_fit(FitArgs& a, Team& team) {
       throw InputError("--spectral-map: needs a collection (two or more inputs)");
     if (o.atlas.deform_nodes > 0 && inputs.size() < 2)
       throw InputError("--deform-nodes: needs a collection (two or more inputs)");
+    if (o.atlas.fine_nodes > 0 && o.atlas.deform_nodes == 0)
+      throw InputError("--fine-nodes: a second field of nodes, needs --deform-nodes > 0");
     if (o.register_nodes && o.atlas.deform_nodes == 0)
       throw InputError("--register: needs --deform-nodes > 0");
     if (o.template_coverage && (inputs.size() < 2 || o.template_shape >= 0))
@@ -723,6 +727,9 @@ void run_fit(FitArgs& a, Team& team) {
     if (!a.quiet && !nodes.target_rms.empty()) {
       std::fprintf(stderr, "fit: %d nodes in the domain, sigma %.4g", o.atlas.deform_nodes,
                    nodes.sigma);
+      if (nodes.fine_sigma > 0)
+        std::fprintf(stderr, "; %d fine nodes from zero, sigma %.4g", o.atlas.fine_nodes,
+                     nodes.fine_sigma);
       if (o.register_nodes) {
         std::fprintf(stderr, "; registration RMS / left by the nodes:");
         for (size_t i = 0; i < nodes.target_rms.size(); ++i)
@@ -1235,6 +1242,18 @@ void add_fit(CLI::App& app) {
   c->add_option("--nodes-width", o.nodes_width,
                 "With --deform-nodes: the kernels' width as a multiple of the centres' spacing in "
                 "the domain (wider: a smoother displacement)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 100.0))
+      ->check(kFinite);
+  c->add_option("--fine-nodes", o.atlas.fine_nodes,
+                "With --deform-nodes: a second field of this many nodes, its own kernels "
+                "(--fine-width), started from zero and learning at the networks' rate whatever "
+                "--nodes-lr-scale says: local changes next to a held registration (0: none)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 4096));
+  c->add_option("--fine-width", o.fine_width,
+                "With --fine-nodes: the second field's width as a multiple of its centres' "
+                "spacing in the domain")
       ->capture_default_str()
       ->check(CLI::Range(0.1, 100.0))
       ->check(kFinite);

@@ -33,16 +33,28 @@ Atlas<T>::Atlas(const AtlasOptions& o) : options_(o) {
     // the kernels' width sigma are placed once (Trainer::finish_template) and
     // read as constants, so Adam never moves them (their gradient is zero).
     phi_nodes_ = params.add("nodes.phi", Index(o.shapes) * o.deform_nodes, 3);
-    phi.set_nodes(params.add("nodes.centres", o.deform_nodes, 2), params.add("nodes.sigma", 1, 1));
+    phi.set_nodes(0, params.add("nodes.centres", o.deform_nodes, 2),
+                  params.add("nodes.sigma", 1, 1));
+  }
+  JSA_CHECK(o.fine_nodes >= 0, "fine_nodes must be >= 0");
+  if (d > 0 && o.fine_nodes > 0) {
+    fine_nodes_ = params.add("nodes.fine.phi", Index(o.shapes) * o.fine_nodes, 3);
+    phi.set_nodes(1, params.add("nodes.fine.centres", o.fine_nodes, 2),
+                  params.add("nodes.fine.sigma", 1, 1));
   }
 }
 
 template <class T>
-Var Atlas<T>::phi_nodes(Tape<T>& t, int shape) {
-  if (phi_nodes_ < 0) return Var{};
+NodeFields Atlas<T>::phi_nodes(Tape<T>& t, int shape) {
   JSA_CHECK(shape >= 0 && shape < options_.shapes, "shape " << shape << " of " << options_.shapes);
-  const Index n = options_.deform_nodes;
-  return slice_rows(t, params.on(t, phi_nodes_), Index(shape) * n, n);
+  NodeFields fields;
+  const int blocks[2] = {phi_nodes_, fine_nodes_};
+  const Index counts[2] = {options_.deform_nodes, options_.fine_nodes};
+  for (int f = 0; f < 2; ++f)
+    if (blocks[f] >= 0)
+      fields[size_t(f)] =
+          slice_rows(t, params.on(t, blocks[f]), Index(shape) * counts[f], counts[f]);
+  return fields;
 }
 
 template <class T>

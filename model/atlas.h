@@ -39,6 +39,11 @@ struct AtlasOptions {
   // point, cannot. The centres are placed after the template start
   // (Trainer::finish_template); until then the term is off. 0: none.
   int deform_nodes = 0;
+  // A second field of nodes next to the first (model/parametrize.h), with its
+  // own centres and width, started from zero whatever the first starts from:
+  // the first can carry a registration held fixed while this one learns the
+  // local changes (issue 19, docs/collections.md "Two fields of nodes"). 0: none.
+  int fine_nodes = 0;
 };
 
 template <class T>
@@ -55,9 +60,9 @@ class Atlas {
   // f_phi,i and f_psi,i (1 x D) of shape i on the tape; invalid Vars for a single shape.
   Var phi_code(Tape<T>& t, int shape);
   Var psi_code(Tape<T>& t, int shape);
-  // t_k,i of shape i (n x 3) on the tape: the node displacements
-  // (AtlasOptions::deform_nodes); an invalid Var without nodes.
-  Var phi_nodes(Tape<T>& t, int shape);
+  // t_k,i of shape i (n x 3) on the tape, one per field of nodes
+  // (AtlasOptions::deform_nodes, fine_nodes); invalid Vars without them.
+  NodeFields phi_nodes(Tape<T>& t, int shape);
 
   const AtlasOptions& options() const { return options_; }
   Parameters<T> params;
@@ -67,8 +72,8 @@ class Atlas {
 
  private:
   AtlasOptions options_;
-  int phi_codes_ = -1, psi_codes_ = -1;  // N x D parameter blocks
-  int phi_nodes_ = -1;                   // (N n) x 3: t_k,i
+  int phi_codes_ = -1, psi_codes_ = -1;   // N x D parameter blocks
+  int phi_nodes_ = -1, fine_nodes_ = -1;  // (N n) x 3: t_k,i of each field
 };
 
 // The reconstruction (Sec. 3): phi of shape `shape` at the rows of uv (V x 2),

@@ -39,14 +39,21 @@ Var held_constant(Tape<T>& t, Var v) {
 // held constant): the key of a look-up (L_6D^h's h_t, L_map's T_i) that is a
 // constant of the step, so backward never reaches this pass. The block is the
 // tape's: read it before the next node is made.
+// A shape's node displacements as constants of the step (held_constant).
+template <class T>
+NodeFields held_nodes(Tape<T>& t, NodeFields nodes) {
+  for (Var& v : nodes)
+    if (v.valid()) v = held_constant(t, v);
+  return nodes;
+}
+
 template <class T>
 const Block<T>& reference_points(Tape<T>& t, Atlas<T>& atlas, Var x_p, int reference) {
   const Var x_fixed = held_constant(t, x_p);
   const Var code_t = atlas.has_codes() ? held_constant(t, atlas.phi_code(t, reference)) : Var{};
-  const Var nodes_t = atlas.phi_nodes(t, reference);
   return t.value(atlas.phi
                      .evaluate(t, atlas.params, x_fixed, false, code_t,
-                               nodes_t.valid() ? held_constant(t, nodes_t) : Var{})
+                               held_nodes(t, atlas.phi_nodes(t, reference)))
                      .points);
 }
 
@@ -165,9 +172,8 @@ Var single_shape_objective(Tape<T>& t, Atlas<T>& atlas, int shape, const Block<T
     // others, moved only by its own shape's terms (which also keeps a
     // data-parallel step exact: a code's gradient stays on its shape's rank).
     const Var ref_code = held_constant(t, atlas.phi_code(t, o.metric_reference));
-    const Var ref_nodes = atlas.phi_nodes(t, o.metric_reference);
     const SurfacePoints ref = atlas.phi.evaluate(
-        t, p, x_p, true, ref_code, ref_nodes.valid() ? held_constant(t, ref_nodes) : Var{});
+        t, p, x_p, true, ref_code, held_nodes(t, atlas.phi_nodes(t, o.metric_reference)));
     const Var metric =
         o.metric_conformal
             ? conformal_metric_mismatch(t, first_m(all.du), first_m(all.dv), ref.du, ref.dv)

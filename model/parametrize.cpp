@@ -24,10 +24,22 @@ Var node_displacement(Tape<T>& t, Var x_rows, Index m, const Block<T>& centres, 
 
 template <class T>
 SurfacePoints Parametrization<T>::evaluate(Tape<T>& t, Parameters<T>& params, Var x,
-                                           bool with_jacobian, Var code, Var nodes) const {
+                                           bool with_jacobian, Var code,
+                                           const NodeFields& nodes) const {
   SurfacePoints s;
-  const T sigma = nodes.valid() && has_nodes() ? params.value(sigma_)(0, 0) : T(0);
-  const bool moves_nodes = sigma > 0;
+  // y + sum over the placed fields of their displacements (value rows m; m < 0: values only)
+  auto displaced = [&](Var y, Var x_rows, Index m) {
+    for (size_t f = 0; f < fields_.size(); ++f) {
+      const Field& field = fields_[f];
+      if (!nodes[f].valid() || field.centres < 0) continue;
+      const T sigma = params.value(field.sigma)(0, 0);
+      if (sigma > 0)
+        y = add(t, y,
+                node_displacement(t, x_rows, m, Block<T>(params.value(field.centres)), sigma,
+                                  nodes[f]));
+    }
+    return y;
+  };
   // phi_i(x) = p + D(p, f_i), p = phi(x), when phi deforms one surface per shape
   // (D(p, x, f_i) when D also reads the domain point: x holds its rows' x).
   const bool reads_domain = deforms_ && deform_.shape().in == 5;
@@ -39,9 +51,7 @@ SurfacePoints Parametrization<T>::evaluate(Tape<T>& t, Parameters<T>& params, Va
   if (!with_jacobian) {
     s.points = mlp_.forward(t, params, x, -1, phi_code);
     if (deforms_) s.points = deformed(s.points, x, -1);
-    if (moves_nodes)
-      s.points = add(t, s.points,
-                     node_displacement(t, x, -1, Block<T>(params.value(centres_)), sigma, nodes));
+    s.points = displaced(s.points, x, -1);
     return s;
   }
   // [x; e_u; e_v] -> [phi(x); J_u; J_v]: one pass, 3M rows (Eq. 1).
@@ -49,8 +59,7 @@ SurfacePoints Parametrization<T>::evaluate(Tape<T>& t, Parameters<T>& params, Va
   const Var x3 = stack_tangents(t, x);
   Var y3 = mlp_.forward(t, params, x3, m, phi_code);
   if (deforms_) y3 = deformed(y3, x3, m);  // [p + D; (I + dD/dp) J_u (+ dD/du); ...]
-  if (moves_nodes)                         // [.. + sum g_k t_k; .. + sum dg_k/du t_k; ...]
-    y3 = add(t, y3, node_displacement(t, x3, m, Block<T>(params.value(centres_)), sigma, nodes));
+  y3 = displaced(y3, x3, m);               // [.. + sum w_k t_k; .. + sum dw_k/du t_k; ...]
   Stacked y = unstack(t, y3);
   s.points = y.value;
   s.du = y.du;

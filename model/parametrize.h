@@ -5,11 +5,16 @@
 // and the normal n = alpha (J_u x J_v) / |J_u x J_v| (Eq. 2) and the isometry
 // term (Eq. 10) are differentiated exactly by backward().
 #pragma once
+#include <array>
 #include <string>
 
 #include "model/mlp.h"
 
 namespace jsa {
+
+// A shape's node displacements t_k,i, one n x 3 block per field of nodes
+// (Atlas::phi_nodes); an invalid Var where a field is absent.
+using NodeFields = std::array<Var, 2>;
 
 struct SurfacePoints {
   Var points;   // phi(x), M x 3
@@ -57,20 +62,23 @@ class Parametrization {
   }
   // x: M x 2 domain points. with_jacobian = false evaluates phi(x) alone.
   // code: the shape's latent code f_phi,i (1 x D) in a collection, else none.
-  // nodes: the shape's node displacements t_k,i (n x 3, Atlas::phi_nodes), or none.
+  // nodes: the shape's node displacements t_k,i (Atlas::phi_nodes), or none.
   SurfacePoints evaluate(Tape<T>& t, Parameters<T>& params, Var x, bool with_jacobian,
-                         Var code = {}, Var nodes = {}) const;
+                         Var code = {}, const NodeFields& nodes = {}) const;
   // The node displacement of a collection (AtlasOptions::deform_nodes):
   //   phi_i(x) <- phi_i(x) + sum_k w_k(x) t_k,i,  w_k = g_k / sum_j g_j,
   //   g_k(x) = exp(-|x - c_k|^2 / (2 sigma^2)),
   // normalised kernels centred at c_k in the domain, so a node moves what the domain puts
   // near c_k and nothing that is merely near it in 3D. `centres` (n x 2) and
   // `sigma` (1 x 1) are parameter blocks read as constants; sigma = 0 (not
-  // yet placed) turns the term off.
-  void set_nodes(int centres, int sigma) { centres_ = centres, sigma_ = sigma; }
-  bool has_nodes() const { return centres_ >= 0; }
-  int node_centres() const { return centres_; }
-  int node_sigma() const { return sigma_; }
+  // yet placed) turns the term off. Up to two fields (field 0: deform_nodes,
+  // field 1: fine_nodes), each with its own kernels, normalised apart and summed.
+  void set_nodes(int field, int centres, int sigma) {
+    fields_.at(size_t(field)) = {centres, sigma};
+  }
+  bool has_nodes(int field = 0) const { return fields_.at(size_t(field)).centres >= 0; }
+  int node_centres(int field = 0) const { return fields_.at(size_t(field)).centres; }
+  int node_sigma(int field = 0) const { return fields_.at(size_t(field)).sigma; }
   const Mlp<T>& mlp() const { return mlp_; }
   T alpha() const { return alpha_; }
   bool deforms() const { return deforms_; }
@@ -80,7 +88,10 @@ class Parametrization {
   Mlp<T> deform_;  // D (deforms_ only)
   T alpha_ = T(0.01);
   bool deforms_ = false;
-  int centres_ = -1, sigma_ = -1;  // parameter blocks of the node kernels (set_nodes)
+  struct Field {
+    int centres = -1, sigma = -1;  // parameter blocks of the node kernels (set_nodes)
+  };
+  std::array<Field, 2> fields_;
 };
 
 }  // namespace jsa

@@ -124,6 +124,9 @@ TEST_CASE("cli: flag values out of range are refused before any work", "[cli]") 
   rejects(fit + "--register-prior -1", 2, "--register-prior");
   const std::string pair = "fit builtin:sphere builtin:torus -o " + fresh_dir("flags") + "/pair ";
   rejects(pair + "--register", 1, "--register: needs --deform-nodes > 0");
+  rejects(pair + "--fine-nodes 16", 1,
+          "--fine-nodes: a second field of nodes, needs --deform-nodes");
+  rejects(fit + "--fine-width 0", 2, "--fine-width");
   rejects(pair + "--template-coverage --template-shape 1", 1, "--template-coverage: chooses");
   rejects(fit + "--template-coverage", 1, "--template-coverage: chooses");
   rejects(pair + "--deform-nodes 16 --template-steps 0", 1,

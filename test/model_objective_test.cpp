@@ -3,6 +3,7 @@
 // for the full method and for each ablation row.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <vector>
 
 #include "engine/ops.h"
 #include "model/objective.h"
@@ -482,12 +483,14 @@ TEST_CASE("objective: node displacement in the domain (deform_nodes): gradients 
   // the gradients of t_k,i, of the domain's means (through x) and of the
   // networks match central differences, the stacked tangents are the
   // derivative of the displaced surface, and sigma = 0 turns the term off.
+  // With a second field (fine_nodes) its kernels add their own normalised sum.
   AtlasOptions ao = small_atlas_options();
   ao.shapes = 2;
   ao.code_size = 4;
   ao.deform_layers = GENERATE(0, 2);
   ao.deform_nodes = 9;
-  INFO("deform_layers " << ao.deform_layers);
+  ao.fine_nodes = GENERATE(0, 4);
+  INFO("deform_layers " << ao.deform_layers << ", fine_nodes " << ao.fine_nodes);
   ao.softplus_beta = 10;  // smooth, so the differences in x cross no kink
   Atlas<double> atlas(ao);
   Rng init(6);
@@ -498,12 +501,23 @@ TEST_CASE("objective: node displacement in the domain (deform_nodes): gradients 
   atlas.params.value(atlas.phi.node_sigma())(0, 0) = 0.3;
   auto nodes = atlas.params.value(atlas.params.find("nodes.phi"));
   for (Index i = 0; i < nodes.size(); ++i) nodes.data()[i] = 0.2 * std::sin(2.0 + 1.7 * double(i));
+  std::vector<const char*> blocks{"nodes.phi", "domain.mu", "codes.phi", "phi.w0", "psi.wf"};
+  // The second field: four centres off the first's grid, a narrower sigma.
+  Block<double> fine_centres(4, 2), fine(8, 3);
+  fine_centres << 0.2, 0.3, 0.8, 0.1, 0.6, 0.7, 0.1, 0.9;
+  for (Index i = 0; i < fine.size(); ++i) fine.data()[i] = 0.15 * std::cos(1.0 + 2.3 * double(i));
+  if (ao.fine_nodes > 0) {
+    REQUIRE(atlas.phi.has_nodes(1));
+    atlas.params.value(atlas.phi.node_centres(1)) = fine_centres;
+    atlas.params.value(atlas.phi.node_sigma(1))(0, 0) = 0.2;
+    atlas.params.value(atlas.params.find("nodes.fine.phi")) = fine;
+    blocks.push_back("nodes.fine.phi");
+  }
   const std::vector<Block<double>> targets{random_targets(32, ao.alpha, 3),
                                            random_targets(32, ao.alpha, 4)};
   Tape<double> tape;
   int checked = 0;
-  const double worst = worst_over_blocks(
-      atlas, targets, {"nodes.phi", "domain.mu", "codes.phi", "phi.w0", "psi.wf"}, tape, checked);
+  const double worst = worst_over_blocks(atlas, targets, blocks, tape, checked);
   INFO(checked << " entries, worst error/tolerance " << worst);
   CHECK(checked > 40);
   CHECK(worst <= 1.0);
@@ -523,17 +537,24 @@ TEST_CASE("objective: node displacement in the domain (deform_nodes): gradients 
   // The displacement is there (the shapes' nodes differ), and sigma = 0 removes it.
   const Block<double> moved = surface_at(atlas, x, 1);
   atlas.params.value(atlas.phi.node_sigma())(0, 0) = 0;
+  if (ao.fine_nodes > 0) atlas.params.value(atlas.phi.node_sigma(1))(0, 0) = 0;
   const Block<double> still = surface_at(atlas, x, 1);
+  // Each field's normalised sum at shape 1's rows of t (n rows per shape).
+  auto field_sum = [&](const Block<double>& c, const Block<double>& t, double sigma,
+                       Index r) -> Eigen::RowVector3d {
+    double total = 0;
+    Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
+    for (Index k = 0; k < c.rows(); ++k) {
+      const double g = std::exp(-0.5 * (x.row(r) - c.row(k)).squaredNorm() / (sigma * sigma));
+      total += g;
+      sum += g * t.row(c.rows() + k);
+    }
+    return sum / total;
+  };
   Block<double> expected = still;
   for (Index r = 0; r < x.rows(); ++r) {
-    double total = 0;
-    Eigen::RowVector3d moved_by = Eigen::RowVector3d::Zero();
-    for (int k = 0; k < 9; ++k) {
-      const double g = std::exp(-0.5 * (x.row(r) - centres.row(k)).squaredNorm() / 0.09);
-      total += g;
-      moved_by += g * nodes.row(9 + k);
-    }
-    expected.row(r) += moved_by / total;
+    expected.row(r) += field_sum(Block<double>(centres), Block<double>(nodes), 0.3, r);
+    if (ao.fine_nodes > 0) expected.row(r) += field_sum(fine_centres, fine, 0.2, r);
   }
   CHECK((moved - still).cwiseAbs().maxCoeff() > 1e-2);
   CHECK((moved - expected).cwiseAbs().maxCoeff() < 1e-12);

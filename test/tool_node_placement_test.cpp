@@ -97,5 +97,59 @@ TEST_CASE("node placement: centres, sigma, and a smooth registration reproduced"
   plain.initialize(init2);
   const jsa::NodePlacementReport q = jsa::place_nodes(plain, 1, nullptr, nullptr);
   CHECK(q.sigma > 0);
+  CHECK(q.fine_sigma == 0);
   CHECK(plain.params.value(plain.params.find("nodes.phi")).cwiseAbs().maxCoeff() == 0);
+}
+
+TEST_CASE("node placement: a second field starts from zero next to a registration",
+          "[node_placement]") {
+  // Two fields (AtlasOptions::fine_nodes): the first fitted to the
+  // registration exactly as without the second, the second placed with its
+  // own count and width and started from zero.
+  jsa::AtlasOptions o = three_shapes();
+  jsa::Atlas<float> one(o);
+  o.fine_nodes = 100;
+  jsa::Atlas<float> two(o);
+  jsa::Rng init(3), init2(3);
+  one.initialize(init);
+  two.initialize(init2);
+  REQUIRE(two.phi.has_nodes(1));
+  REQUIRE(!one.phi.has_nodes(1));
+  jsa::Rng draw(5);
+  Block<double> uv, points, normals;
+  jsa::sample_reconstruction(one, 2000, draw, uv, points, normals, 0);
+  const Block<float> vertices = points.cast<float>();
+  std::vector<Block<float>> images(3);
+  images[1] = bent(vertices);
+  images[2] = vertices.rowwise() + Eigen::RowVector3f(0.1f, -0.05f, 0.2f);
+  jsa::NodePlacementOptions wide;
+  wide.fine_width = 3;
+  const jsa::NodePlacementReport r1 = jsa::place_nodes(one, 0, &vertices, &images, wide);
+  jsa::NodePlacementOptions narrow = wide;
+  narrow.fine_width = 0.5;
+  const jsa::NodePlacementReport r2 = jsa::place_nodes(two, 0, &vertices, &images, narrow);
+  // The first field does not see the second.
+  CHECK(r2.sigma == r1.sigma);
+  CHECK(two.params.value(two.params.find("nodes.phi")) ==
+        one.params.value(one.params.find("nodes.phi")));
+  // The second: its width, 100 distinct centres, zero displacements.
+  REQUIRE(r2.fine_sigma > 0);
+  CHECK(two.params.value(two.phi.node_sigma(1))(0, 0) == Approx(r2.fine_sigma));
+  const auto fine_centres = two.params.value(two.phi.node_centres(1));
+  REQUIRE(fine_centres.rows() == 100);
+  for (int k = 1; k < 100; ++k) CHECK((fine_centres.row(k) - fine_centres.row(0)).norm() > 0);
+  CHECK(two.params.value(two.params.find("nodes.fine.phi")).cwiseAbs().maxCoeff() == 0);
+  // More centres sit closer: at the same width factor the second field is
+  // narrower than the first (64 centres), here by the factors' ratio too.
+  CHECK(r2.fine_sigma < 0.5 * r2.sigma);
+  // The surfaces of the two atlases agree (a zero field moves nothing).
+  jsa::Rng again(9);
+  Block<double> uv2, p0, n0;
+  jsa::sample_reconstruction(one, 300, again, uv2, p0, n0, 0);
+  for (int i : {0, 1, 2}) {
+    Block<double> a, na, b, nb;
+    jsa::evaluate_surface(one, uv2, a, na, i);
+    jsa::evaluate_surface(two, uv2, b, nb, i);
+    CHECK((a - b).cwiseAbs().maxCoeff() < 1e-5);
+  }
 }

@@ -450,6 +450,36 @@ TEST_CASE(
   CHECK(entry(a, "phi.deform.w0") != deform);
 }
 
+TEST_CASE("trainer: nodes_lr_scale holds the first field of nodes, the second learns",
+          "[trainer]") {
+  // Two fields (atlas.deform_nodes, atlas.fine_nodes): nodes_lr_scale 0 keeps
+  // the first where the placement left it, the second moves from zero.
+  FitOptions o = small_options();
+  o.threads = 1;
+  o.iterations = 10;
+  o.atlas.deform_nodes = 8;
+  o.atlas.fine_nodes = 12;
+  o.nodes_lr_scale = 0;
+  Trainer t(o, two_spheres());
+  t.train_template(3);
+  t.finish_template();
+  const Parameters<float>& p = t.atlas().params;
+  auto block = [&](const char* name) {
+    const auto& e = p.entry(p.find(name));
+    return std::vector<float>(p.values().begin() + long(e.offset),
+                              p.values().begin() + long(e.offset + size_t(e.rows * e.cols)));
+  };
+  REQUIRE(t.atlas().phi.has_nodes(1));
+  CHECK(p.value(t.atlas().phi.node_sigma(1))(0, 0) > 0);  // placed with the first
+  const std::vector<float> held = block("nodes.phi"), fine = block("nodes.fine.phi");
+  for (float v : fine) REQUIRE(v == 0);
+  for (int i = 0; i < 3; ++i) t.step();
+  CHECK(block("nodes.phi") == held);
+  double moved = 0;
+  for (float v : block("nodes.fine.phi")) moved += std::abs(double(v));
+  CHECK(moved > 0);
+}
+
 TEST_CASE("trainer: L_6D^h (intrinsic) in the first intrinsic_until of the run, then L_6D",
           "[trainer]") {
   // Pools of 9 columns: [x_S, n_S, h_S], h a function of the point (here its

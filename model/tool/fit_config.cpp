@@ -52,7 +52,8 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
                 {"softplus_beta", o.atlas.softplus_beta},
                 {"deform_layers", o.atlas.deform_layers},
                 {"deform_domain", o.atlas.deform_domain},
-                {"deform_nodes", o.atlas.deform_nodes}};
+                {"deform_nodes", o.atlas.deform_nodes},
+                {"fine_nodes", o.atlas.fine_nodes}};
   j["weights"] = {{"surface_6d", o.weights.surface},
                   {"chart_2d", o.weights.chart},
                   {"cycle", o.weights.cycle},
@@ -113,6 +114,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["register_prior"] = o.register_prior;
   j["nodes_lr_scale"] = o.nodes_lr_scale;
   j["nodes_width"] = o.nodes_width;
+  j["fine_width"] = o.fine_width;
   j["parallel_shapes"] = o.parallel_shapes;
   j["pool"] = o.pool;
   j["threads"] = o.threads;
@@ -161,6 +163,10 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (a.contains("deform_nodes")) field(a, "atlas.", "deform_nodes", o.atlas.deform_nodes);
   if (o.atlas.deform_nodes < 0 || o.atlas.deform_nodes > 4096)
     throw InputError(what + ": atlas.deform_nodes must be in [0, 4096]");
+  o.atlas.fine_nodes = 0;  // later addition: absent = none
+  if (a.contains("fine_nodes")) field(a, "atlas.", "fine_nodes", o.atlas.fine_nodes);
+  if (o.atlas.fine_nodes < 0 || o.atlas.fine_nodes > 4096)
+    throw InputError(what + ": atlas.fine_nodes must be in [0, 4096]");
   const json& w = j.contains("weights") ? j["weights"] : json();
   field(w, "weights.", "surface_6d", o.weights.surface);
   field(w, "weights.", "chart_2d", o.weights.chart);
@@ -280,6 +286,10 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (j.contains("nodes_width")) field(j, "", "nodes_width", o.nodes_width);
   if (!(o.nodes_width > 0) || !std::isfinite(o.nodes_width))
     throw InputError(what + ": nodes_width must be positive");
+  o.fine_width = 1;  // later addition: absent = the default (used only with atlas.fine_nodes)
+  if (j.contains("fine_width")) field(j, "", "fine_width", o.fine_width);
+  if (!(o.fine_width > 0) || !std::isfinite(o.fine_width))
+    throw InputError(what + ": fine_width must be positive");
   o.parallel_shapes = false;  // later addition: runs before it took one shape at a time
   if (j.contains("parallel_shapes")) field(j, "", "parallel_shapes", o.parallel_shapes);
   o.metric_end = -1;  // later addition: absent = a constant lambda_metric

@@ -25,24 +25,12 @@ std::vector<Index> farthest_points(const Block<double>& points, Index n) {
   return chosen;
 }
 
-}  // namespace
-
-NodePlacementReport place_nodes(Atlas<float>& atlas, int template_shape,
-                                const Block<float>* template_vertices,
-                                const std::vector<Block<float>>* images,
-                                const NodePlacementOptions& o) {
-  Parametrization<float>& phi = atlas.phi;
-  JSA_CHECK(phi.has_nodes(), "place_nodes: the atlas has no nodes (deform_nodes = 0)");
-  const int n = atlas.options().deform_nodes;
-  const int shapes = atlas.shapes();
-  JSA_CHECK(o.samples >= n, "place_nodes: fewer samples than nodes");
-  // The template's surface at samples of P (its nodes are still off: sigma = 0).
-  Rng rng(o.seed, 0x6e6f646573ULL);  // "nodes": a stream of its own
-  Block<double> x, points, normals;
-  sample_reconstruction(atlas, o.samples, rng, x, points, normals, template_shape);
-
-  // c_k: farthest points on the surface, so every part of it has nodes
-  // whatever the domain's stretch there; sigma from their spacing in the domain.
+// One field's kernels: c_k the farthest points of the template's surface
+// (their domain points x, so every part of it has nodes whatever the domain's
+// stretch there), sigma = width x the centres' mean spacing in the domain.
+// Returns the centres; writes them and sigma into the field's blocks.
+Block<double> place_kernels(Atlas<float>& atlas, int field, int n, const Block<double>& x,
+                            const Block<double>& points, double width, double& sigma) {
   const std::vector<Index> chosen = farthest_points(points, n);
   Block<double> centres(n, 2);
   for (int k = 0; k < n; ++k) centres.row(k) = x.row(chosen[size_t(k)]);
@@ -54,13 +42,40 @@ NodePlacementReport place_nodes(Atlas<float>& atlas, int template_shape,
         nearest_sq = std::min(nearest_sq, (centres.row(k) - centres.row(j)).squaredNorm());
     spacing += std::sqrt(nearest_sq);
   }
-  const double sigma = o.width * spacing / n;
+  sigma = width * spacing / n;
   JSA_CHECK(sigma > 0 && std::isfinite(sigma), "place_nodes: the centres coincide");
-  atlas.params.value(phi.node_centres()) = centres.cast<float>();
-  atlas.params.value(phi.node_sigma())(0, 0) = float(sigma);
+  atlas.params.value(atlas.phi.node_centres(field)) = centres.cast<float>();
+  atlas.params.value(atlas.phi.node_sigma(field))(0, 0) = float(sigma);
+  return centres;
+}
+
+}  // namespace
+
+NodePlacementReport place_nodes(Atlas<float>& atlas, int template_shape,
+                                const Block<float>* template_vertices,
+                                const std::vector<Block<float>>* images,
+                                const NodePlacementOptions& o) {
+  Parametrization<float>& phi = atlas.phi;
+  JSA_CHECK(phi.has_nodes(), "place_nodes: the atlas has no nodes (deform_nodes = 0)");
+  const int n = atlas.options().deform_nodes;
+  const int shapes = atlas.shapes();
+  JSA_CHECK(o.samples >= std::max(n, atlas.options().fine_nodes),
+            "place_nodes: fewer samples than nodes");
+  // The template's surface at samples of P (its nodes are still off: sigma = 0).
+  Rng rng(o.seed, 0x6e6f646573ULL);  // "nodes": a stream of its own
+  Block<double> x, points, normals;
+  sample_reconstruction(atlas, o.samples, rng, x, points, normals, template_shape);
 
   NodePlacementReport report;
+  double sigma = 0;
+  const Block<double> centres = place_kernels(atlas, 0, n, x, points, o.width, sigma);
   report.sigma = sigma;
+  // The second field (AtlasOptions::fine_nodes) starts from zero: it learns
+  // what the first, fitted to the registration or not, leaves.
+  if (phi.has_nodes(1)) {
+    place_kernels(atlas, 1, atlas.options().fine_nodes, x, points, o.fine_width, report.fine_sigma);
+    atlas.params.value(atlas.params.find("nodes.fine.phi")).setZero();
+  }
   report.target_rms.assign(size_t(shapes), 0.0);
   report.residual_rms.assign(size_t(shapes), 0.0);
   auto displacements = atlas.params.value(atlas.params.find("nodes.phi"));

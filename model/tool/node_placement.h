@@ -16,14 +16,15 @@
 namespace jsa {
 
 struct NodePlacementOptions {
-  int samples = 20000;  // domain points drawn from P to place and fit the nodes
-  double width = 2.0;   // sigma as a multiple of the centres' mean spacing in the domain
-  double ridge = 1e-4;  // Tikhonov weight, relative to the mean diagonal of G^T G
+  int samples = 20000;      // domain points drawn from P to place and fit the nodes
+  double width = 2.0;       // sigma as a multiple of the centres' mean spacing in the domain
+  double fine_width = 1.0;  // the same for the second field (AtlasOptions::fine_nodes)
+  double ridge = 1e-4;      // Tikhonov weight, relative to the mean diagonal of G^T G
   uint64_t seed = 1;
 };
 
 struct NodePlacementReport {
-  double sigma = 0;
+  double sigma = 0, fine_sigma = 0;  // the fields' widths (fine_sigma 0: no second field)
   // per shape: RMS of the registration's displacement, and of what the nodes
   // leave of it after the fit (0 / 0 for the template and without a registration)
   std::vector<double> target_rms, residual_rms;

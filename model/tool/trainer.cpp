@@ -61,6 +61,7 @@ static void validate(const FitOptions& o) {
   require(o.spectral_map >= 0 && std::isfinite(o.spectral_map),
           "spectral_map must be >= 0 and finite");
   require(o.nodes_width > 0 && std::isfinite(o.nodes_width), "nodes_width must be positive");
+  require(o.fine_width > 0 && std::isfinite(o.fine_width), "fine_width must be positive");
   require(o.spectral_map_until > 0 && o.spectral_map_until <= 1,
           "spectral_map_until must be in (0, 1]");
   require(o.surface_lr_scale >= 0 && std::isfinite(o.surface_lr_scale),
@@ -375,6 +376,7 @@ void Trainer::finish_template() {
     NodePlacementOptions np;
     np.seed = options_.seed;
     np.width = options_.nodes_width;
+    np.fine_width = options_.fine_width;
     const Block<float>* vertices = map_surface_ ? &map_surface_->points() : nullptr;
     node_report_ = place_nodes(*atlas_, options_.template_shape, vertices,
                                vertices ? &map_images_ : nullptr, np);

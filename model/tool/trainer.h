@@ -193,6 +193,9 @@ struct FitOptions {
   // 2 carried the registration best (1, 3 and 4 behind; docs/collections.md,
   // twenty-first round).
   double nodes_width = 2;
+  // ... and the second field's (atlas.fine_nodes), which starts from zero and
+  // learns at the networks' rate whatever nodes_lr_scale says.
+  double fine_width = 1;
   // Collections: lambda_metric moves from weights.metric at the first joint
   // step to this value at the first learning-rate decay (geometrically;
   // model/tool/schedule.h, scheduled_weight), then stays. < 0: constant.
