@@ -127,6 +127,7 @@ auto with_flag_names(F&& f) {
       {"nodes_width", "--nodes-width"},
       {"atlas.deform_nodes", "--deform-nodes"},
       {"atlas.fine_nodes", "--fine-nodes"},
+      {"atlas.chart_width", "--chart-width"},
       {"fine_width", "--fine-width"},
       {"schedule.kind", "--schedule"},
       {"schedule.points_start", "--points-start"},
@@ -1027,6 +1028,11 @@ void add_fit(CLI::App& app) {
        "Hidden units of phi and psi (collections: " + std::to_string(kCollectionWidth) + ")")
       ->capture_default_str()
       ->check(CLI::Range(4, 4096));
+  c->add_option("--chart-width", o.atlas.chart_width,
+                "Hidden units of psi alone (0: --width); beyond the paper, for a chart that "
+                "inverts phi where one as wide as phi cannot")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 4096));
   c->add_option("--depth", o.atlas.hidden_layers, "Hidden layers of phi and psi")
       ->capture_default_str()
       ->check(CLI::Range(1, 32));

@@ -21,8 +21,9 @@ Atlas<T>::Atlas(const AtlasOptions& o) : options_(o) {
     phi = Parametrization<T>(
         params, MlpShape{2, 3, o.width, o.hidden_layers, d, o.code_layer, o.softplus_beta},
         T(o.alpha));
-  psi =
-      Chart<T>(params, MlpShape{6, 2, o.width, o.hidden_layers, d, o.code_layer, o.softplus_beta});
+  JSA_CHECK(o.chart_width >= 0, "chart_width must be >= 0");
+  psi = Chart<T>(params, MlpShape{6, 2, o.chart_width > 0 ? o.chart_width : o.width,
+                                  o.hidden_layers, d, o.code_layer, o.softplus_beta});
   if (d > 0) {
     phi_codes_ = params.add("codes.phi", o.shapes, d);
     psi_codes_ = params.add("codes.psi", o.shapes, d);

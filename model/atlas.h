@@ -11,9 +11,14 @@
 namespace jsa {
 
 struct AtlasOptions {
-  int gaussians = 10000;       // K, the number of Gaussians in P (paper: 10^4)
-  int width = 256;             // hidden units of phi and psi (paper: 256)
-  int hidden_layers = 5;       // hidden layers of phi and psi (paper: 5)
+  int gaussians = 10000;  // K, the number of Gaussians in P (paper: 10^4)
+  int width = 256;        // hidden units of phi and psi (paper: 256)
+  int hidden_layers = 5;  // hidden layers of phi and psi (paper: 5)
+  // Hidden units of psi alone when > 0 (beyond the paper, which sizes both
+  // alike): psi must invert phi everywhere, thin parts included, and the
+  // chart rule trails the nearest-sample rule where it cannot (issue 19,
+  // docs/collections.md, twenty-third round). 0: width.
+  int chart_width = 0;
   double alpha = 0.01;         // norm of the normals fed to psi and produced by phi6 (paper: 0.01)
   bool gaussian_noise = true;  // sample P (true) or the means alone (Table 1 rows 6-8)
   int shapes = 1;              // N shapes sharing the domain (Sec. 3.4); > 1 adds latent codes

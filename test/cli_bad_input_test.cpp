@@ -127,6 +127,7 @@ TEST_CASE("cli: flag values out of range are refused before any work", "[cli]") 
   rejects(pair + "--fine-nodes 16", 1,
           "--fine-nodes: a second field of nodes, needs --deform-nodes");
   rejects(fit + "--fine-width 0", 2, "--fine-width");
+  rejects(fit + "--chart-width -1", 2, "--chart-width");
   rejects(pair + "--template-coverage --template-shape 1", 1, "--template-coverage: chooses");
   rejects(fit + "--template-coverage", 1, "--template-coverage: chooses");
   rejects(pair + "--deform-nodes 16 --template-steps 0", 1,

@@ -177,6 +177,34 @@ TEST_CASE(
   CHECK(worst <= 1.0);
 }
 
+TEST_CASE("objective: a chart of its own width (chart_width): psi's layers, gradients",
+          "[objective]") {
+  // psi takes chart_width hidden units, phi keeps width; every psi block's
+  // gradient (and phi's first layer's) matches central differences.
+  AtlasOptions ao = small_atlas_options();
+  ao.shapes = 2;
+  ao.code_size = 4;
+  ao.chart_width = ao.width + 5;
+  Atlas<double> atlas(ao);
+  Rng init(5);
+  atlas.initialize(init);
+  const auto& psi_in = atlas.params.entry(atlas.params.find("psi.w0"));
+  const auto& phi_in = atlas.params.entry(atlas.params.find("phi.w0"));
+  CHECK(psi_in.cols == ao.chart_width);
+  CHECK(phi_in.cols == ao.width);
+  CHECK(atlas.params.entry(atlas.params.find("psi.w1")).rows == ao.chart_width);
+  const std::vector<Block<double>> targets{random_targets(32, ao.alpha, 3),
+                                           random_targets(32, ao.alpha, 4)};
+  Tape<double> tape;
+  int checked = 0;
+  const double worst = worst_over_blocks(
+      atlas, targets, {"psi.w0", "psi.w1", "psi.b1", "psi.wf", "codes.psi", "phi.w0"}, tape,
+      checked);
+  INFO(checked << " entries, worst error/tolerance " << worst);
+  CHECK(checked > 40);
+  CHECK(worst <= 1.0);
+}
+
 TEST_CASE("objective: ablation rows switch the terms on one by one", "[objective]") {
   CHECK_FALSE(Components::table_row(6).normals);
   CHECK(Components::table_row(7).normals);

@@ -219,6 +219,7 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   d.template_coverage = true;
   d.atlas.fine_nodes = 64;
   d.fine_width = 0.5;
+  d.atlas.chart_width = 96;
   const jsa::FitOptions nodes = jsa::fit_options_from_json(jsa::fit_options_to_json(d), "x");
   CHECK(nodes.atlas.deform_nodes == 128);
   CHECK(nodes.register_nodes);
@@ -228,11 +229,12 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   CHECK(nodes.template_coverage);
   CHECK(nodes.atlas.fine_nodes == 64);
   CHECK(nodes.fine_width == 0.5);
+  CHECK(nodes.atlas.chart_width == 96);
   std::string before_nodes = jsa::fit_options_to_json(d, -1);
   for (const std::string key :
        {",\"deform_nodes\":128", ",\"register_nodes\":true", ",\"register_prior\":0.3",
         ",\"nodes_lr_scale\":0.5", ",\"nodes_width\":1.5", ",\"template_coverage\":true",
-        ",\"fine_nodes\":64", ",\"fine_width\":0.5"}) {
+        ",\"fine_nodes\":64", ",\"fine_width\":0.5", ",\"chart_width\":96"}) {
     const auto at = before_nodes.find(key);
     INFO(key);
     REQUIRE(at != std::string::npos);
@@ -247,6 +249,7 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   CHECK(!no_nodes.template_coverage);
   CHECK(no_nodes.atlas.fine_nodes == 0);
   CHECK(no_nodes.fine_width == 1);
+  CHECK(no_nodes.atlas.chart_width == 0);
   std::string zero_width = jsa::fit_options_to_json(d, -1);
   const std::string width_key = ",\"nodes_width\":1.5";
   zero_width.replace(zero_width.find(width_key), width_key.size(), ",\"nodes_width\":0.0");
@@ -259,6 +262,7 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   d.nodes_width = jsa::FitOptions{}.nodes_width;
   d.atlas.fine_nodes = 0;
   d.fine_width = 1;
+  d.atlas.chart_width = 0;
   // L_6D^h's weight and its stage: kept when set, off (and the whole run) when absent.
   d.intrinsic = 0.25;
   d.intrinsic_until = 0.5;

@@ -44,6 +44,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   json j;
   j["atlas"] = {{"gaussians", o.atlas.gaussians},
                 {"width", o.atlas.width},
+                {"chart_width", o.atlas.chart_width},
                 {"hidden_layers", o.atlas.hidden_layers},
                 {"alpha", o.atlas.alpha},
                 {"shapes", o.atlas.shapes},
@@ -145,6 +146,8 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   const json& a = j.contains("atlas") ? j["atlas"] : json();
   field(a, "atlas.", "gaussians", o.atlas.gaussians);
   field(a, "atlas.", "width", o.atlas.width);
+  o.atlas.chart_width = 0;  // later addition: absent = psi as wide as phi
+  if (a.contains("chart_width")) field(a, "atlas.", "chart_width", o.atlas.chart_width);
   field(a, "atlas.", "hidden_layers", o.atlas.hidden_layers);
   field(a, "atlas.", "alpha", o.atlas.alpha);
   field(a, "atlas.", "shapes", o.atlas.shapes);
@@ -328,19 +331,19 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
     if (!parse_gemm(name, &o.gemm))
       throw InputError(what + ": field 'gemm' must be \"eigen\" or \"blas\"");
   }
-  if (o.atlas.gaussians <= 0 || o.atlas.width <= 0 || o.atlas.hidden_layers < 0 || o.points <= 0 ||
-      o.atlas.shapes <= 0 || o.atlas.code_size <= 0 || o.pool <= 0 || o.threads < 0 ||
-      o.orient_every < 0 || o.batch_shapes < 0 || o.wrap_steps < 0 || o.reseed_every < 0 ||
-      o.atlas.code_layer < 0 || o.atlas.code_layer > 1 || !(o.lr > 0) ||
-      !(o.atlas.softplus_beta >= 0) || !std::isfinite(o.atlas.softplus_beta) ||
+  if (o.atlas.gaussians <= 0 || o.atlas.width <= 0 || o.atlas.chart_width < 0 ||
+      o.atlas.hidden_layers < 0 || o.points <= 0 || o.atlas.shapes <= 0 || o.atlas.code_size <= 0 ||
+      o.pool <= 0 || o.threads < 0 || o.orient_every < 0 || o.batch_shapes < 0 ||
+      o.wrap_steps < 0 || o.reseed_every < 0 || o.atlas.code_layer < 0 || o.atlas.code_layer > 1 ||
+      !(o.lr > 0) || !(o.atlas.softplus_beta >= 0) || !std::isfinite(o.atlas.softplus_beta) ||
       !std::isfinite(o.lr) || o.max_faults < 0 ||
       !(o.fault_lr_factor > 0 && o.fault_lr_factor <= 1))
     throw InputError(what + ": sizes must be positive");
   // The same bounds as the command line's, so a crafted file cannot make the
   // atlas allocate without limit.
-  if (o.atlas.gaussians > 1000000 || o.atlas.width > 4096 || o.atlas.hidden_layers > 32 ||
-      o.atlas.code_size > 4096 || o.atlas.shapes > 100000 || o.points > 1000000 ||
-      o.pool > 10000000 || o.threads > 1024 || o.wrap_steps > 1000000)
+  if (o.atlas.gaussians > 1000000 || o.atlas.width > 4096 || o.atlas.chart_width > 4096 ||
+      o.atlas.hidden_layers > 32 || o.atlas.code_size > 4096 || o.atlas.shapes > 100000 ||
+      o.points > 1000000 || o.pool > 10000000 || o.threads > 1024 || o.wrap_steps > 1000000)
     throw InputError(what + ": a size is beyond the command line's limits (corrupt settings?)");
   return o;
 }
