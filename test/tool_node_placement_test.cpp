@@ -38,6 +38,23 @@ Block<float> bent(const Block<float>& v) {
   return out;
 }
 
+// The template's "mesh": 2000 points of the atlas's own surface (shape 0),
+// and its registration to shapes 1 (bent) and 2 (shifted).
+struct Registration {
+  Block<float> vertices;
+  std::vector<Block<float>> images;
+};
+
+Registration registration_of(jsa::Atlas<float>& atlas) {
+  jsa::Rng draw(5);
+  Block<double> uv, points, normals;
+  jsa::sample_reconstruction(atlas, 2000, draw, uv, points, normals, 0);
+  Registration r{points.cast<float>(), std::vector<Block<float>>(3)};
+  r.images[1] = bent(r.vertices);
+  r.images[2] = r.vertices.rowwise() + Eigen::RowVector3f(0.1f, -0.05f, 0.2f);
+  return r;
+}
+
 }  // namespace
 
 TEST_CASE("node placement: centres, sigma, and a smooth registration reproduced",
@@ -45,14 +62,9 @@ TEST_CASE("node placement: centres, sigma, and a smooth registration reproduced"
   jsa::Atlas<float> atlas(three_shapes());
   jsa::Rng init(3);
   atlas.initialize(init);
-  // The template's "mesh": 2000 points of its own surface (shape 0).
-  jsa::Rng draw(5);
-  Block<double> uv, points, normals;
-  jsa::sample_reconstruction(atlas, 2000, draw, uv, points, normals, 0);
-  const Block<float> vertices = points.cast<float>();
-  std::vector<Block<float>> images(3);
-  images[1] = bent(vertices);
-  images[2] = vertices.rowwise() + Eigen::RowVector3f(0.1f, -0.05f, 0.2f);
+  const Registration reg = registration_of(atlas);
+  const Block<float>& vertices = reg.vertices;
+  const std::vector<Block<float>>& images = reg.images;
 
   const jsa::NodePlacementReport r = jsa::place_nodes(atlas, 0, &vertices, &images);
   REQUIRE(r.target_rms.size() == 3);
@@ -115,13 +127,9 @@ TEST_CASE("node placement: a second field starts from zero next to a registratio
   two.initialize(init2);
   REQUIRE(two.phi.has_nodes(1));
   REQUIRE(!one.phi.has_nodes(1));
-  jsa::Rng draw(5);
-  Block<double> uv, points, normals;
-  jsa::sample_reconstruction(one, 2000, draw, uv, points, normals, 0);
-  const Block<float> vertices = points.cast<float>();
-  std::vector<Block<float>> images(3);
-  images[1] = bent(vertices);
-  images[2] = vertices.rowwise() + Eigen::RowVector3f(0.1f, -0.05f, 0.2f);
+  const Registration reg = registration_of(one);
+  const Block<float>& vertices = reg.vertices;
+  const std::vector<Block<float>>& images = reg.images;
   jsa::NodePlacementOptions wide;
   wide.fine_width = 3;
   const jsa::NodePlacementReport r1 = jsa::place_nodes(one, 0, &vertices, &images, wide);
