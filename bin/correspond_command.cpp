@@ -16,6 +16,7 @@
 #include "model/tool/checkpoint.h"
 #include "model/tool/correspondence.h"
 #include "model/tool/fit_config.h"
+#include "model/tool/geodesic_refinement.h"
 #include "model/tool/shape_input.h"
 #include "model/tool/spectral_refinement.h"
 
@@ -73,8 +74,9 @@ struct CorrespondArgs {
   std::string run, points_file, out;
   std::vector<long> vertices;
   int from = 0, to = 1, threads = 0;
-  bool snap = false, nearest_rule = false, spectral = false;
+  bool snap = false, nearest_rule = false, spectral = false, geodesic = false;
   SpectralRefinementOptions spectral_options;
+  GeodesicRefinementOptions geodesic_options;
 };
 
 // Flags of the spectral refinement, shared by correspond and eval-corr.
@@ -104,6 +106,41 @@ void add_spectral_flags(CLI::App* c, bool& on, SpectralRefinementOptions& o) {
   c->add_flag("--spectral-consensus", o.consensus,
               "--spectral, 3 or more shapes: per point, the medoid of every map's estimate "
               "(the atlas's, both directions', and through each other shape)");
+}
+
+// Flags of the geodesic refinement, shared by correspond and eval-corr.
+void add_geodesic_flags(CLI::App* c, bool& on, GeodesicRefinementOptions& o) {
+  c->add_flag("--geodesic", on,
+              "Finish the map by geodesic landmarks: I's farthest points carried by the map, "
+              "each point matched by its distances along the surface to them (meshes only)");
+  c->add_option("--geodesic-landmarks", o.landmarks, "--geodesic: landmarks per shape")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 4096));
+  c->add_option("--geodesic-tau", o.tau,
+                "--geodesic: landmark k weighs exp(-d_k / tau), d_k in sqrt(A / 4 pi) (0: all 1)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e6));
+  c->add_option("--geodesic-cycle", o.cycle_tolerance,
+                "--geodesic: leave out a landmark the map does not carry back to within this "
+                "(unit frame; 0: keep all)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e6));
+}
+
+// The map's image moved to the target's nearest input vertex.
+CorrespondenceMap snapped(CorrespondenceMap base, const std::vector<Mesh>& meshes,
+                          const std::vector<Normalization>& frames) {
+  auto vertices = std::make_shared<std::vector<Block<double>>>();
+  for (size_t s = 0; s < meshes.size(); ++s)
+    vertices->push_back(frames[s].to_unit(meshes[s].vertices));
+  return [base, vertices](int from, int to, const Block<double>& p, const Block<double>& n) {
+    const Block<double> q = base(from, to, p, n);
+    std::vector<int> at;
+    nearest(q, (*vertices)[size_t(to)], at);
+    Block<double> out(q.rows(), 3);
+    for (Index m = 0; m < q.rows(); ++m) out.row(m) = (*vertices)[size_t(to)].row(at[size_t(m)]);
+    return out;
+  };
 }
 
 void run_correspond(const CorrespondArgs& a) {
@@ -148,6 +185,11 @@ void run_correspond(const CorrespondArgs& a) {
     for (const std::string& input : r.contents.inputs) meshes.push_back(load_shape(input));
     map = spectral_refinement(map, meshes, r.contents.normalizations, a.spectral_options);
   }
+  if (a.geodesic) {
+    std::vector<Mesh> meshes;
+    for (const std::string& input : r.contents.inputs) meshes.push_back(load_shape(input));
+    map = geodesic_refinement(map, meshes, r.contents.normalizations, a.geodesic_options);
+  }
   const Block<double> q = fj.from_unit(map(a.from, a.to, fi.to_unit(p), fi.normals_to_unit(pn)));
   std::vector<int> snapped;
   if (a.snap) {
@@ -172,9 +214,10 @@ void run_correspond(const CorrespondArgs& a) {
 struct EvalCorrArgs {
   std::string run;
   std::vector<std::string> keypoints;
-  bool nearest_rule = false, spectral = false;
+  bool nearest_rule = false, spectral = false, geodesic = false, snap = false;
   int threads = 0, refine = 0;
   SpectralRefinementOptions spectral_options;
+  GeodesicRefinementOptions geodesic_options;
 };
 
 void run_eval_corr(const EvalCorrArgs& a) {
@@ -217,6 +260,9 @@ void run_eval_corr(const EvalCorrArgs& a) {
     std::fprintf(stderr, "refining by ZoomOut: %zu shapes x %d eigenfunctions, %zu ordered pairs\n",
                  n, a.spectral_options.functions, n * (n - 1));
   }
+  if (a.geodesic)
+    map = geodesic_refinement(map, meshes, r.contents.normalizations, a.geodesic_options);
+  if (a.snap) map = snapped(map, meshes, r.contents.normalizations);
   const KeypointError e = keypoint_error(map, meshes, r.contents.normalizations, keypoints);
   std::string rule = !co.use_chart         ? "nearest-sample rule, no chart"
                      : co.refine_steps > 0 ? "q = phi_J(u), u = psi_I(p) refined by " +
@@ -227,6 +273,9 @@ void run_eval_corr(const EvalCorrArgs& a) {
             (a.spectral_options.consensus         ? " (consensus of the collection)"
              : a.spectral_options.both_directions ? " (both directions)"
                                                   : "");
+  if (a.geodesic)
+    rule += ", finished by " + std::to_string(a.geodesic_options.landmarks) + " geodesic landmarks";
+  if (a.snap) rule += ", snapped to the target's vertices";
   std::printf("correspondence error over %lld ordered pairs x %lld keypoints (%s)\n",
               (long long)e.pairs, (long long)e.keypoints, rule.c_str());
   std::printf("  mean L2 in the target's unit frame: %.3f x 1e-2\n", 100 * e.mean);
@@ -246,6 +295,12 @@ void run_eval_corr(const EvalCorrArgs& a) {
                      {"prior_until", so.prior_until}, {"both_directions", so.both_directions},
                      {"consensus", so.consensus}};
   }
+  j["geodesic_refinement"] = a.geodesic;
+  if (a.geodesic)
+    j["geodesic"] = {{"landmarks", a.geodesic_options.landmarks},
+                     {"tau", a.geodesic_options.tau},
+                     {"cycle_tolerance", a.geodesic_options.cycle_tolerance}};
+  j["snap"] = a.snap;
   j["mean_l2_unit_frame"] = e.mean;
   j["mean_l2_x1e-2"] = 100 * e.mean;
   j["pairs"] = e.pairs;
@@ -280,6 +335,7 @@ void add_correspond(CLI::App& app) {
   c->add_flag("--nearest-rule", a->nearest_rule,
               "Use the paper's nearest-sample rule instead of the chart psi");
   add_spectral_flags(c, a->spectral, a->spectral_options);
+  add_geodesic_flags(c, a->geodesic, a->geodesic_options);
   c->add_option("-o,--out", a->out, "Write the points to this file instead of standard output");
   c->add_option("--threads", a->threads, "Threads (0: all cores)")
       ->capture_default_str()
@@ -304,6 +360,10 @@ void add_eval_corr(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0, 1000));
   add_spectral_flags(c, a->spectral, a->spectral_options);
+  add_geodesic_flags(c, a->geodesic, a->geodesic_options);
+  c->add_flag("--snap", a->snap,
+              "Move each image to the target's nearest input vertex (what the rule's error is "
+              "without phi_J's distance from the mesh)");
   c->add_option("--threads", a->threads, "Threads (0: all cores)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1024));

@@ -97,6 +97,14 @@ TEST_CASE("cli: keypoint indices beyond the mesh are rejected with file and line
   rejects(eval + dir + "/b.vts --spectral", 1,
           "shape 0 has 4 vertices, fewer than 60 eigenfunctions (--spectral-functions)");
   rejects(eval + dir + "/b.vts --spectral-functions 1", 2, "--spectral-functions");
+  // The geodesic refinement takes at most every vertex as a landmark.
+  const Result g = run(eval + dir + "/b.vts --geodesic --snap");
+  INFO(g.output);
+  CHECK(g.code == 0);
+  CHECK(g.output.find("finished by 256 geodesic landmarks, snapped to the target's vertices") !=
+        std::string::npos);
+  rejects(eval + dir + "/b.vts --geodesic-landmarks 0", 2, "--geodesic-landmarks");
+  rejects(eval + dir + "/b.vts --geodesic-tau -1", 2, "--geodesic-tau");
 }
 
 TEST_CASE("cli: flag values out of range are refused before any work", "[cli]") {
