@@ -28,7 +28,7 @@ namespace jsa {
 
 struct GeodesicRefinementOptions {
   int landmarks = 256;  // K
-  double tau = 0.2;    // the landmarks' weights' length (0: all weigh 1)
+  double tau = 0.2;     // the landmarks' weights' length (0: all weigh 1)
   // A landmark whose image, carried back to I by the atlas, lands farther than
   // this from it (unit frame of I) is left out of the pair's (0: none left out).
   double cycle_tolerance = 0;
