@@ -128,6 +128,8 @@ auto with_flag_names(F&& f) {
       {"atlas.deform_nodes", "--deform-nodes"},
       {"atlas.fine_nodes", "--fine-nodes"},
       {"atlas.chart_width", "--chart-width"},
+      {"atlas.chart_fourier", "--chart-fourier"},
+      {"atlas.chart_fourier_sigma", "--chart-fourier-sigma"},
       {"fine_width", "--fine-width"},
       {"schedule.kind", "--schedule"},
       {"schedule.points_start", "--points-start"},
@@ -1033,6 +1035,16 @@ void add_fit(CLI::App& app) {
                 "inverts phi where one as wide as phi cannot")
       ->capture_default_str()
       ->check(CLI::Range(0, 4096));
+  c->add_option("--chart-fourier", o.atlas.chart_fourier,
+                "psi's input widened by this many random Fourier features of the point, "
+                "[p, alpha n, sin(p B), cos(p B)] (0: the paper's psi); beyond the paper")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 4096));
+  c->add_option("--chart-fourier-sigma", o.atlas.chart_fourier_sigma,
+                "With --chart-fourier: the frequencies' standard deviation (unit frame)")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-3, 1e3))
+      ->check(kFinite);
   c->add_option("--depth", o.atlas.hidden_layers, "Hidden layers of phi and psi")
       ->capture_default_str()
       ->check(CLI::Range(1, 32));

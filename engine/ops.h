@@ -6,7 +6,7 @@
 //                       softplus_stacked as one op, in row tiles (the hidden
 //                       layers of the softplus MLPs)
 //   ops_elementwise.cpp add/sub/mul (row broadcasting), scale, offset, square,
-//                       sqrt, exp, log
+//                       sqrt, exp, log, sin_cos
 //   ops_rows.cpp        concat/slice of columns and rows, gather rows by index
 //   ops_reduce.cpp      sum, mean, row_dot, row_norm, row_normalize, cross3
 //   ops_kernels.cpp     gaussian_weights_stacked: normalised Gaussian kernels
@@ -71,6 +71,10 @@ Var exp(Tape<T>& t, Var x);
 // The natural logarithm; x > 0 (the caller's floor: no eps here).
 template <class T>
 Var log(Tape<T>& t, Var x);
+// [sin x, cos x]: N x C -> N x 2C, the two halves of random Fourier features
+// (model/chart.h).
+template <class T>
+Var sin_cos(Tape<T>& t, Var x);
 
 // ---- rows and columns (ops_rows.cpp) ----
 // xs: a braced list {a, b} or a vector (VarList, engine/tape.h).

@@ -199,6 +199,21 @@ Var log(Tape<T>& t, Var x) {
   return y;
 }
 
+// y = [sin x, cos x] ;  dx += cos x dy_sin - sin x dy_cos (read off y itself)
+template <class T>
+Var sin_cos(Tape<T>& t, Var x) {
+  const Index c = t.cols(x);
+  Var y = t.node(t.rows(x), 2 * c, {x});
+  t.value(y).leftCols(c) = t.value(x).array().sin();
+  t.value(y).rightCols(c) = t.value(x).array().cos();
+  t.on_backward(y, [x, c](Tape<T>& t, Var y) {
+    const auto v = t.value(y).array();
+    const auto g = t.grad(y).array();
+    t.grad(x).array() += v.rightCols(c) * g.leftCols(c) - v.leftCols(c) * g.rightCols(c);
+  });
+  return y;
+}
+
 #define JSA_INSTANTIATE(T)                  \
   template Var add<T>(Tape<T>&, Var, Var);  \
   template Var sub<T>(Tape<T>&, Var, Var);  \
@@ -208,7 +223,8 @@ Var log(Tape<T>& t, Var x) {
   template Var square<T>(Tape<T>&, Var);    \
   template Var sqrt<T>(Tape<T>&, Var, T);   \
   template Var exp<T>(Tape<T>&, Var);       \
-  template Var log<T>(Tape<T>&, Var);
+  template Var log<T>(Tape<T>&, Var);       \
+  template Var sin_cos<T>(Tape<T>&, Var);
 JSA_INSTANTIATE(float)
 JSA_INSTANTIATE(double)
 

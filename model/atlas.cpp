@@ -22,8 +22,12 @@ Atlas<T>::Atlas(const AtlasOptions& o) : options_(o) {
         params, MlpShape{2, 3, o.width, o.hidden_layers, d, o.code_layer, o.softplus_beta},
         T(o.alpha));
   JSA_CHECK(o.chart_width >= 0, "chart_width must be >= 0");
-  psi = Chart<T>(params, MlpShape{6, 2, o.chart_width > 0 ? o.chart_width : o.width,
-                                  o.hidden_layers, d, o.code_layer, o.softplus_beta});
+  JSA_CHECK(o.chart_fourier >= 0 && o.chart_fourier_sigma > 0,
+            "chart_fourier must be >= 0 and chart_fourier_sigma > 0");
+  psi = Chart<T>(params,
+                 MlpShape{6 + 2 * o.chart_fourier, 2, o.chart_width > 0 ? o.chart_width : o.width,
+                          o.hidden_layers, d, o.code_layer, o.softplus_beta},
+                 o.chart_fourier, o.chart_fourier_sigma);
   if (d > 0) {
     phi_codes_ = params.add("codes.phi", o.shapes, d);
     psi_codes_ = params.add("codes.psi", o.shapes, d);

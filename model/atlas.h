@@ -19,6 +19,15 @@ struct AtlasOptions {
   // chart rule trails the nearest-sample rule where it cannot (issue 19,
   // docs/collections.md, twenty-third round). 0: width.
   int chart_width = 0;
+  // psi's input widened by random Fourier features of the point (beyond the
+  // paper; Tancik et al., NeurIPS 2020): [p, alpha n, sin(p B), cos(p B)], B a
+  // fixed 3 x F matrix of N(0, sigma^2) entries. A ReLU MLP of low-frequency
+  // inputs bends slowly; the features let a narrow psi fold where phi's inverse
+  // folds (two legs side by side in 3D, apart in the domain) for the cost of a
+  // wider first layer (issue 19, docs/collections.md, twenty-fourth round).
+  // 0: none, the paper's psi.
+  int chart_fourier = 0;
+  double chart_fourier_sigma = 4;
   double alpha = 0.01;         // norm of the normals fed to psi and produced by phi6 (paper: 0.01)
   bool gaussian_noise = true;  // sample P (true) or the means alone (Table 1 rows 6-8)
   int shapes = 1;              // N shapes sharing the domain (Sec. 3.4); > 1 adds latent codes

@@ -136,6 +136,8 @@ TEST_CASE("cli: flag values out of range are refused before any work", "[cli]") 
           "--fine-nodes: a second field of nodes, needs --deform-nodes");
   rejects(fit + "--fine-width 0", 2, "--fine-width");
   rejects(fit + "--chart-width -1", 2, "--chart-width");
+  rejects(fit + "--chart-fourier -1", 2, "--chart-fourier");
+  rejects(fit + "--chart-fourier-sigma 0", 2, "--chart-fourier-sigma");
   rejects(pair + "--template-coverage --template-shape 1", 1, "--template-coverage: chooses");
   rejects(fit + "--template-coverage", 1, "--template-coverage: chooses");
   rejects(pair + "--deform-nodes 16 --template-steps 0", 1,

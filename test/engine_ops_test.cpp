@@ -98,6 +98,9 @@ std::vector<GradCase> op_cases() {
   // x in [0.2, 2): away from log's pole at 0.
   add_case("log", [](T& t, const Vs& x) { return log(t, x[0]); },
            {uniform_block(rng, n, c, 0.2, 2.0)});
+  // x over several periods: both halves' derivatives change sign.
+  add_case("sin_cos", [](T& t, const Vs& x) { return sin_cos(t, x[0]); },
+           {uniform_block(rng, n, c, -7.0, 7.0)});
 
   // ---- rows and columns ----
   add_case("concat_cols", [](T& t, const Vs& x) { return concat_cols(t, x); },

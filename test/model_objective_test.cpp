@@ -177,20 +177,28 @@ TEST_CASE(
   CHECK(worst <= 1.0);
 }
 
-TEST_CASE("objective: a chart of its own width (chart_width): psi's layers, gradients",
-          "[objective]") {
-  // psi takes chart_width hidden units, phi keeps width; every psi block's
-  // gradient (and phi's first layer's) matches central differences.
+TEST_CASE(
+    "objective: a chart of its own width and input (chart_width, chart_fourier): "
+    "psi's layers, gradients",
+    "[objective]") {
+  // psi takes chart_width hidden units, phi keeps width; with chart_fourier F
+  // psi reads 6 + 2F columns. Every psi block's gradient, and phi's first
+  // layer's (L_cycle's psi(phi6(x)) carries the features' chain rule back
+  // into phi), matches central differences.
   AtlasOptions ao = small_atlas_options();
   ao.shapes = 2;
   ao.code_size = 4;
   ao.chart_width = ao.width + 5;
+  ao.chart_fourier = GENERATE(0, 6);
+  ao.chart_fourier_sigma = 3;
+  INFO("chart_fourier " << ao.chart_fourier);
   Atlas<double> atlas(ao);
   Rng init(5);
   atlas.initialize(init);
   const auto& psi_in = atlas.params.entry(atlas.params.find("psi.w0"));
   const auto& phi_in = atlas.params.entry(atlas.params.find("phi.w0"));
   CHECK(psi_in.cols == ao.chart_width);
+  CHECK(psi_in.rows == 6 + 2 * ao.chart_fourier);  // the code has a block of its own
   CHECK(phi_in.cols == ao.width);
   CHECK(atlas.params.entry(atlas.params.find("psi.w1")).rows == ao.chart_width);
   const std::vector<Block<double>> targets{random_targets(32, ao.alpha, 3),

@@ -220,6 +220,8 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   d.atlas.fine_nodes = 64;
   d.fine_width = 0.5;
   d.atlas.chart_width = 96;
+  d.atlas.chart_fourier = 16;
+  d.atlas.chart_fourier_sigma = 2.5;
   const jsa::FitOptions nodes = jsa::fit_options_from_json(jsa::fit_options_to_json(d), "x");
   CHECK(nodes.atlas.deform_nodes == 128);
   CHECK(nodes.register_nodes);
@@ -230,11 +232,14 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   CHECK(nodes.atlas.fine_nodes == 64);
   CHECK(nodes.fine_width == 0.5);
   CHECK(nodes.atlas.chart_width == 96);
+  CHECK(nodes.atlas.chart_fourier == 16);
+  CHECK(nodes.atlas.chart_fourier_sigma == 2.5);
   std::string before_nodes = jsa::fit_options_to_json(d, -1);
   for (const std::string key :
        {",\"deform_nodes\":128", ",\"register_nodes\":true", ",\"register_prior\":0.3",
         ",\"nodes_lr_scale\":0.5", ",\"nodes_width\":1.5", ",\"template_coverage\":true",
-        ",\"fine_nodes\":64", ",\"fine_width\":0.5", ",\"chart_width\":96"}) {
+        ",\"fine_nodes\":64", ",\"fine_width\":0.5", ",\"chart_width\":96", ",\"chart_fourier\":16",
+        ",\"chart_fourier_sigma\":2.5"}) {
     const auto at = before_nodes.find(key);
     INFO(key);
     REQUIRE(at != std::string::npos);
@@ -250,6 +255,8 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   CHECK(no_nodes.atlas.fine_nodes == 0);
   CHECK(no_nodes.fine_width == 1);
   CHECK(no_nodes.atlas.chart_width == 0);
+  CHECK(no_nodes.atlas.chart_fourier == 0);
+  CHECK(no_nodes.atlas.chart_fourier_sigma == jsa::AtlasOptions{}.chart_fourier_sigma);
   std::string zero_width = jsa::fit_options_to_json(d, -1);
   const std::string width_key = ",\"nodes_width\":1.5";
   zero_width.replace(zero_width.find(width_key), width_key.size(), ",\"nodes_width\":0.0");
@@ -263,6 +270,8 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   d.atlas.fine_nodes = 0;
   d.fine_width = 1;
   d.atlas.chart_width = 0;
+  d.atlas.chart_fourier = 0;
+  d.atlas.chart_fourier_sigma = jsa::AtlasOptions{}.chart_fourier_sigma;
   // L_6D^h's weight and its stage: kept when set, off (and the whole run) when absent.
   d.intrinsic = 0.25;
   d.intrinsic_until = 0.5;

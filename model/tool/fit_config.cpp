@@ -45,6 +45,8 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["atlas"] = {{"gaussians", o.atlas.gaussians},
                 {"width", o.atlas.width},
                 {"chart_width", o.atlas.chart_width},
+                {"chart_fourier", o.atlas.chart_fourier},
+                {"chart_fourier_sigma", o.atlas.chart_fourier_sigma},
                 {"hidden_layers", o.atlas.hidden_layers},
                 {"alpha", o.atlas.alpha},
                 {"shapes", o.atlas.shapes},
@@ -148,6 +150,15 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   field(a, "atlas.", "width", o.atlas.width);
   o.atlas.chart_width = 0;  // later addition: absent = psi as wide as phi
   if (a.contains("chart_width")) field(a, "atlas.", "chart_width", o.atlas.chart_width);
+  o.atlas.chart_fourier = 0;  // later additions: absent = the paper's psi
+  o.atlas.chart_fourier_sigma = AtlasOptions{}.chart_fourier_sigma;
+  if (a.contains("chart_fourier")) field(a, "atlas.", "chart_fourier", o.atlas.chart_fourier);
+  if (a.contains("chart_fourier_sigma"))
+    field(a, "atlas.", "chart_fourier_sigma", o.atlas.chart_fourier_sigma);
+  if (o.atlas.chart_fourier < 0 || o.atlas.chart_fourier > 4096 ||
+      !(o.atlas.chart_fourier_sigma > 0) || !std::isfinite(o.atlas.chart_fourier_sigma))
+    throw InputError(what + ": atlas.chart_fourier must be in [0, 4096] and " +
+                     "atlas.chart_fourier_sigma positive");
   field(a, "atlas.", "hidden_layers", o.atlas.hidden_layers);
   field(a, "atlas.", "alpha", o.atlas.alpha);
   field(a, "atlas.", "shapes", o.atlas.shapes);
