@@ -239,6 +239,7 @@ TEST_CASE("keypoint_error: a map that carries each shape exactly onto another sc
   const KeypointError e = keypoint_error(identity, meshes, frames, keypoints);
   CHECK(e.pairs == 2);
   CHECK(e.mean < 1e-12);
+  CHECK(e.mean_squared < 1e-12);
   CHECK(e.self_mean < 1e-12);
   // A map that always answers the unit frame's origin is off by |q_gt|, about 1 on the sphere.
   const CorrespondenceMap centre = [](int, int, const Block<double>& p, const Block<double>&) {
@@ -251,6 +252,16 @@ TEST_CASE("keypoint_error: a map that carries each shape exactly onto another sc
   REQUIRE(c.keypoint_mean.size() == 3);
   for (size_t m = 0; m < 3; ++m)
     CHECK(c.keypoint_mean[m] == Approx(unit.row(keypoints[0][m]).norm()).epsilon(1e-9));
+  // The squared reading is the mean of the squares, not the square of the mean:
+  // keypoint m moved by 0.1 (m + 1) scores 0.2 and (0.01 + 0.04 + 0.09) / 3.
+  const CorrespondenceMap spread = [](int, int, const Block<double>& p, const Block<double>&) {
+    Block<double> q = p;
+    for (Index r = 0; r < q.rows(); ++r) q(r, 0) += 0.1 * double(r + 1);
+    return q;
+  };
+  const KeypointError sq = keypoint_error(spread, meshes, frames, keypoints);
+  CHECK(sq.mean == Approx(0.2).epsilon(1e-9));
+  CHECK(sq.mean_squared == Approx(0.14 / 3).epsilon(1e-9));
   // The self-maps (the diagonal) are off by the same distances, and kept out of the mean.
   double self = 0;
   for (size_t m = 0; m < 3; ++m) self += unit.row(keypoints[0][m]).norm() / 3;

@@ -251,6 +251,10 @@ TEST_CASE(
   CHECK(r.output.find("refined by ZoomOut") != std::string::npos);
   CHECK(read_text(dir + "/eval_corr.json").find("\"spectral_refinement\": true") !=
         std::string::npos);
+  // Both readings of the paper's L2: the mean distance and the mean squared one.
+  CHECK(r.output.find("mean squared distance") != std::string::npos);
+  CHECK(read_text(dir + "/eval_corr.json").find("\"mean_squared_unit_frame\"") !=
+        std::string::npos);
   const std::string stem = fs::path(texture).stem().string();
   for (int i = 0; i < 3; ++i) {
     const std::string sub = dir + "/shape_" + std::to_string(i);

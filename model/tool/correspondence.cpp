@@ -112,7 +112,7 @@ KeypointError keypoint_error(const CorrespondenceMap& map, const std::vector<Mes
   e.pair_mean.assign(n, std::vector<double>(n, 0.0));
   e.keypoint_mean.assign(k, 0.0);
   e.keypoint_self.assign(k, 0.0);
-  double total = 0;
+  double total = 0, total_squared = 0;
   for (size_t i = 0; i < n; ++i) {
     const Block<double> unit = frames[i].to_unit(meshes[i].vertices);
     const Block<double> normals = frames[i].normals_to_unit(vertex_normals_of(meshes[i]));
@@ -139,6 +139,7 @@ KeypointError keypoint_error(const CorrespondenceMap& map, const std::vector<Mes
       for (size_t m = 0; m < k; ++m) {
         const double d = (q.row(Index(m)) - target.row(keypoints[j][m])).norm();
         pair += d;
+        total_squared += d * d;
         e.keypoint_mean[m] += d;
         for (size_t t = 0; t < thresholds.size(); ++t)
           if (d <= thresholds[t]) e.within[t] += 1;
@@ -152,6 +153,7 @@ KeypointError keypoint_error(const CorrespondenceMap& map, const std::vector<Mes
   const double count = double(e.pairs) * double(k);
   if (count > 0) {
     e.mean = total / count;
+    e.mean_squared = total_squared / count;
     for (double& w : e.within) w /= count;
     for (double& w : e.keypoint_mean) w /= double(e.pairs);
   }

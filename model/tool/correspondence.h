@@ -33,7 +33,11 @@ Block<double> correspond(Atlas<float>& atlas, int from, int to, const Block<doub
 Block<double> vertex_normals_of(const Mesh& mesh);
 
 struct KeypointError {
-  double mean = 0;             // mean |q - q_gt| over all ordered pairs, unit frame of the target
+  double mean = 0;  // mean |q - q_gt| over all ordered pairs, unit frame of the target
+  // mean |q - q_gt|^2, the same pairs: the paper's "L2" (Sec. 4.2) is written
+  // as a mean distance, but its Table 1 does not state units, and a mean
+  // squared distance is the other common reading (docs/collections.md).
+  double mean_squared = 0;
   std::vector<double> within;  // fraction of keypoints within each threshold
   std::vector<double> thresholds;
   Index pairs = 0, keypoints = 0;

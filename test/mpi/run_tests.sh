@@ -32,7 +32,7 @@ printf 'builtin:sphere\nbuiltin:torus\nbuiltin:cube\nbuiltin:capsule\n' > shapes
 # shape 0 there): the 1-process reference must train the same way.
 fit=(fit --list shapes.txt --iters 12 -M 64 -K 64 --width 16 --depth 2 --code-size 8 --pool 2000
      --threads 1 --orient-every 4 --mesh-resolution 8 --checkpoint-every 0 --seed 5 -q
-     --template-steps 0 --template-shape 0 --no-align)
+     --template-steps 0 --template-shape 0 --no-align --w-metric 1e-2)
 launch=("$mpiexec" --oversubscribe --bind-to none)
 [ "$(id -u)" -eq 0 ] && launch+=(--allow-run-as-root)
 run() {  # run NP ARGS...: one process without mpirun, else NP ranks
