@@ -44,17 +44,16 @@ struct FitOptions {
     // input out with fewer flipped triangles (measured in docs/method.md,
     // "lambda_cycle").
     weights.cycle = 0.1;
-    // Collections: L_metric (beyond the paper; losses/isometry.h) is off
-    // unless --w-metric asks. It once carried the ants' keypoints 12.8 -> 11.4
-    // x 1e-2 at 10 minutes (docs/collections.md, fourth round), before the
-    // template start, the deformation and the pose step held the layouts;
-    // today it is level at fixed work on both families (four runs), costs
-    // 1.27x a joint step, and pulls towards an isometry that these families
-    // (7-16% apart in distances along the surface, bench_family_isometry) do
-    // not have. Thirty minutes of the ants without it: 3.84 / 3.39 x 1e-2
-    // (chart / nearest) against 4.17 / 4.22, every shape closer to its floor
-    // (twenty-fifth round). No effect on a single shape.
-    weights.metric = 0;
+    // Collections: L_metric (beyond the paper; losses/isometry.h). It first
+    // carried the ants' keypoints 12.8 -> 11.4 x 1e-2 at 10 minutes
+    // (docs/collections.md, fourth round). Today it costs 1.27x a joint step
+    // and is level at fixed work, and these families are 7-16% from isometric
+    // (bench_family_isometry), yet without it one ant of four swapped legs in
+    // ten minutes (seed 2: 8.16 against 4.80) and the teddies lost 0.3 on the
+    // mean of three seeds; what it buys is a guard against such swaps, not
+    // precision (twenty-fifth and twenty-sixth rounds). No effect on a single
+    // shape.
+    weights.metric = 1e-2;
     // L_even (beyond the paper; losses/evenness.h) in the second half of a
     // single shape's run. At 1e-2 it took the five-minute EMD of the samples
     // through P and phi from 2.1-2.7x its floor to 1.1-1.8x (docs/results.md,
