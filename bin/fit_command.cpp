@@ -104,6 +104,7 @@ auto with_flag_names(F&& f) {
       {"weights.transport", "--w-emd"},
       {"weights.coverage", "--w-coverage"},
       {"metric_end", "--w-metric-end"},
+      {"metric_until", "--w-metric-until"},
       {"repulsion_tolerance", "--repulsion-tolerance"},
       {"wrap_steps", "--wrap"},
       {"reseed_every", "--reseed"},
@@ -1000,9 +1001,16 @@ void add_fit(CLI::App& app) {
       ->check(CLI::NonNegativeNumber)
       ->check(kFinite);
   c->add_option("--w-metric-end", o.metric_end,
-                "Collections: lambda_metric moves geometrically from --w-metric at the first "
-                "joint step to this at the first learning-rate decay (-1: constant)")
+                "Collections: lambda_metric moves from --w-metric at the first joint step to this "
+                "at --w-metric-until (geometrically; linearly to 0), then stays (-1: constant)")
       ->capture_default_str()
+      ->check(kFinite);
+  c->add_option("--w-metric-until", o.metric_until,
+                "Collections: the fraction of the joint steps where --w-metric-end is reached (-1: "
+                "the first learning-rate decay); by default L_metric guards the first quarter, "
+                "where the layouts are decided")
+      ->capture_default_str()
+      ->check(CLI::Range(-1.0, 1.0))
       ->check(kFinite);
   c->add_flag("--metric-conformal", o.metric_conformal,
               "Collections: L_metric compares the shapes' metrics up to a scale per point "

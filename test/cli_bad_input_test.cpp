@@ -123,6 +123,9 @@ TEST_CASE("cli: flag values out of range are refused before any work", "[cli]") 
   rejects(fit + "--intrinsic 0.5", 1, "--intrinsic: needs a collection");
   rejects(fit + "--spectral-map -1", 2, "--spectral-map");
   rejects(fit + "--spectral-map-until 1.5", 2, "--spectral-map-until");
+  rejects(fit + "--w-metric-until 1.5", 2, "--w-metric-until");
+  // 0 is in the flag's range; the run's settings refuse it (exit 1, as a setting).
+  rejects(fit + "--w-metric-until 0", 1, "--w-metric-until must be in (0, 1]");
   rejects(fit + "--spectral-map 1", 1, "--spectral-map: needs a collection");
   // The node displacement and its registration: collections only, nodes first.
   rejects(fit + "--deform-nodes -1", 2, "--deform-nodes");

@@ -171,6 +171,22 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   std::string huge = jsa::fit_options_to_json(m, -1);
   huge.replace(huge.find(end_key), end_key.size(), ",\"metric_end\":1e999");
   CHECK_THROWS(jsa::fit_options_from_json(huge, "big"));
+  // ... and where it is reached (a later addition): kept, absent = the first
+  // decay, out of (0, 1] refused.
+  jsa::FitOptions u;
+  u.metric_until = 0.2;
+  CHECK(jsa::fit_options_from_json(jsa::fit_options_to_json(u), "x").metric_until == 0.2);
+  std::string before_until = jsa::fit_options_to_json(u, -1);
+  const std::string until_key = ",\"metric_until\":0.2";
+  const auto until_at = before_until.find(until_key);
+  REQUIRE(until_at != std::string::npos);
+  before_until.erase(until_at, until_key.size());
+  CHECK(jsa::fit_options_from_json(before_until, "old").metric_until == -1);
+  for (const char* bad : {"0", "1.5", "1e999"}) {
+    std::string b = jsa::fit_options_to_json(u, -1);
+    b.replace(b.find(until_key), until_key.size(), std::string(",\"metric_until\":") + bad);
+    CHECK_THROWS(jsa::fit_options_from_json(b, "bad"));
+  }
   // The conformal L_metric (a later addition): kept, absent = isometric.
   jsa::FitOptions c;
   c.metric_conformal = true;

@@ -99,6 +99,37 @@ TEST_CASE("schedule: a weight moves geometrically to its end value, then stays",
   CHECK(jsa::scheduled_weight(1e-2, -1, 0.5, 250, 1000) == 1e-2);
 }
 
+TEST_CASE("schedule: lambda_metric ends at the first decay or where --w-metric-until says",
+          "[schedule]") {
+  jsa::FitOptions o;
+  o.iterations = 1000;
+  o.weights.metric = 1e-2;
+  // The default: linearly to 0 over the first quarter of the joint steps.
+  CHECK(jsa::metric_weight_at(o, 0) == Approx(1e-2));
+  CHECK(jsa::metric_weight_at(o, 125) == Approx(5e-3));
+  CHECK(jsa::metric_weight_at(o, 250) == 0);
+  CHECK(jsa::metric_weight_at(o, 999) == 0);
+  // Constant over the whole run (metric_end < 0) ...
+  o.metric_end = -1;
+  CHECK(jsa::metric_weight_at(o, 999) == 1e-2);
+  // ... to 0 by the first decay (0.75 of the run) ...
+  o.metric_end = 0;
+  o.metric_until = -1;
+  REQUIRE(o.decay_at.front() == 0.75);
+  CHECK(jsa::metric_weight_at(o, 375) == Approx(5e-3));
+  CHECK(jsa::metric_weight_at(o, 750) == 0);
+  // ... or by a fifth of it, then off (the objective skips a zero-weight term).
+  o.metric_until = 0.2;
+  CHECK(jsa::metric_weight_at(o, 0) == Approx(1e-2));
+  CHECK(jsa::metric_weight_at(o, 100) == Approx(5e-3));
+  CHECK(jsa::metric_weight_at(o, 200) == 0);
+  CHECK(jsa::metric_weight_at(o, 999) == 0);
+  // Without decays the move spans the run.
+  o.metric_until = -1;
+  o.decay_at.clear();
+  CHECK(jsa::metric_weight_at(o, 500) == Approx(5e-3));
+}
+
 TEST_CASE("schedule: stored in the run's settings, older runs read as step",
           "[schedule][fit_config]") {
   jsa::FitOptions o;

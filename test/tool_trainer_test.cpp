@@ -358,7 +358,8 @@ TEST_CASE("trainer: shapes split over threads give the serial step's gradient", 
     FitOptions o = small_options();
     o.iterations = 10;
     o.batch_shapes = batch;
-    o.weights.metric = 1e-2;  // off by default; its reference must split too
+    o.weights.metric = 1e-2;  // its reference must split too, and on in every
+    o.metric_end = -1;        // compared step (by default it ends at a quarter)
     FitOptions serial = o;
     serial.parallel_shapes = false;
     Trainer p(o, three), q(o, three), s(serial, three);

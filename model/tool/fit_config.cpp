@@ -105,6 +105,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["transport_from"] = o.transport_from;
   j["transport_points"] = o.transport_points;
   j["metric_end"] = o.metric_end;
+  j["metric_until"] = o.metric_until;
   j["metric_conformal"] = o.metric_conformal;
   j["code_lr_scale"] = o.code_lr_scale;
   j["surface_lr_scale"] = o.surface_lr_scale;
@@ -309,6 +310,10 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   o.metric_end = -1;  // later addition: absent = a constant lambda_metric
   if (j.contains("metric_end")) field(j, "", "metric_end", o.metric_end);
   if (!std::isfinite(o.metric_end)) throw InputError(what + ": metric_end must be finite");
+  o.metric_until = -1;  // later addition: absent = the first learning-rate decay
+  if (j.contains("metric_until")) field(j, "", "metric_until", o.metric_until);
+  if (!(o.metric_until < 0 || (o.metric_until > 0 && o.metric_until <= 1)))
+    throw InputError(what + ": metric_until must be in (0, 1] or < 0");
   o.template_shape = 0;  // later addition: absent = shape 0, what older runs used
   if (j.contains("template_shape")) field(j, "", "template_shape", o.template_shape);
   o.metric_conformal = false;  // later addition: absent = the isometric L_metric

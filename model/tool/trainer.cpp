@@ -54,6 +54,8 @@ static void validate(const FitOptions& o) {
   require(o.transport_from >= 0 && o.transport_from <= 1, "transport_from must be in [0, 1]");
   require(o.transport_points >= 1, "transport_points must be >= 1");
   require(std::isfinite(o.metric_end), "metric_end must be finite (< 0: lambda_metric constant)");
+  require(o.metric_until < 0 || (o.metric_until > 0 && o.metric_until <= 1),
+          "metric_until must be in (0, 1] (< 0: the first learning-rate decay)");
   require(o.code_lr_scale > 0 && std::isfinite(o.code_lr_scale),
           "code_lr_scale must be positive and finite");
   require(o.intrinsic >= 0 && std::isfinite(o.intrinsic), "intrinsic must be >= 0 and finite");
@@ -423,9 +425,7 @@ bool Trainer::train_on(const std::vector<int>& batch, double lr, bool template_s
   ObjectiveOptions objective{options_.weights, options_.components, options_.repulsion_tolerance};
   if (atlas_->shapes() > 1) objective.metric_reference = options_.template_shape;  // L_metric's
   objective.metric_conformal = options_.metric_conformal;
-  objective.weights.metric = scheduled_weight(
-      options_.weights.metric, options_.metric_end,
-      options_.decay_at.empty() ? 1.0 : options_.decay_at.front(), counter, options_.iterations);
+  objective.weights.metric = metric_weight_at(options_, counter);
   // The staged objective (FitOptions::chart_from): phi and P alone at first.
   if (double(iteration_) < options_.chart_from * double(options_.iterations))
     objective.components.chart = false;
