@@ -17,12 +17,23 @@ std::string message_of(const std::string& text) {
   return "";
 }
 
-// The defaults written out, with `from` (first occurrence) replaced by `to`.
-std::string edited(const std::string& from, const std::string& to) {
-  std::string text = jsa::fit_options_to_json(jsa::FitOptions(), -1);
-  const auto at = text.find(from);
+// `text` with `key` (first occurrence, which must be there) replaced by `to`;
+// removing a key is how a settings file from before the key existed reads.
+std::string replaced(std::string text, const std::string& key, const std::string& to = "") {
+  const auto at = text.find(key);
+  INFO(key);
   REQUIRE(at != std::string::npos);
-  return text.replace(at, from.size(), to);
+  return text.replace(at, key.size(), to);
+}
+
+// The settings `o` written out compactly, with `key` replaced by `to`.
+std::string written(const jsa::FitOptions& o, const std::string& key, const std::string& to = "") {
+  return replaced(jsa::fit_options_to_json(o, -1), key, to);
+}
+
+// The defaults written out, with `from` replaced by `to`.
+std::string edited(const std::string& from, const std::string& to) {
+  return written(jsa::FitOptions(), from, to);
 }
 
 }  // namespace
@@ -110,11 +121,8 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   std::string old = jsa::fit_options_to_json(o, -1);
   for (const std::string key :
        {"\"orient_every\":25,", "\"batch_shapes\":3,", ",\"wrap_steps\":40", ",\"reseed_every\":60",
-        ",\"dense_surface\":true", "\"softplus_beta\":7.5,"}) {
-    const auto at = old.find(key);
-    REQUIRE(at != std::string::npos);
-    old.erase(at, key.size());
-  }
+        ",\"dense_surface\":true", "\"softplus_beta\":7.5,"})
+    old = replaced(old, key);
   const jsa::FitOptions legacy = jsa::fit_options_from_json(old, "old");
   CHECK(legacy.orient_every == 0);
   CHECK(legacy.batch_shapes == 0);
@@ -134,11 +142,8 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   {
     jsa::FitOptions p;
     p.gemm = jsa::Gemm::blas;
-    std::string text = jsa::fit_options_to_json(p, -1);
-    const std::string key = ",\"gemm\":\"blas\"";
-    const auto at = text.find(key);
-    REQUIRE(at != std::string::npos);
-    CHECK(jsa::fit_options_from_json(text.erase(at, key.size()), "old").gemm == jsa::Gemm::eigen);
+    CHECK(jsa::fit_options_from_json(written(p, ",\"gemm\":\"blas\""), "old").gemm ==
+          jsa::Gemm::eigen);
   }
   CHECK(message_of(edited("\"gemm\":\"eigen\"", "\"gemm\":\"fast\"")) ==
         "run/model.ckpt: field 'gemm' must be \"eigen\" or \"blas\"");
@@ -151,52 +156,32 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
     p.parallel_shapes = split;
     CHECK(jsa::fit_options_from_json(jsa::fit_options_to_json(p), "x").parallel_shapes == split);
   }
-  std::string before_split = jsa::fit_options_to_json(jsa::FitOptions{}, -1);
-  const std::string key = ",\"parallel_shapes\":true";
-  const auto at = before_split.find(key);
-  REQUIRE(at != std::string::npos);
-  before_split.erase(at, key.size());
-  CHECK(!jsa::fit_options_from_json(before_split, "old").parallel_shapes);
+  CHECK(!jsa::fit_options_from_json(written(jsa::FitOptions{}, ",\"parallel_shapes\":true"), "old")
+             .parallel_shapes);
   // lambda_metric's end value (a later addition): kept, absent = constant, and
   // a non-finite one refused.
   jsa::FitOptions m;
   m.metric_end = 0.1;
   CHECK(jsa::fit_options_from_json(jsa::fit_options_to_json(m), "x").metric_end == 0.1);
-  std::string before_end = jsa::fit_options_to_json(m, -1);
   const std::string end_key = ",\"metric_end\":0.1";
-  const auto end_at = before_end.find(end_key);
-  REQUIRE(end_at != std::string::npos);
-  before_end.erase(end_at, end_key.size());
-  CHECK(jsa::fit_options_from_json(before_end, "old").metric_end == -1);
-  std::string huge = jsa::fit_options_to_json(m, -1);
-  huge.replace(huge.find(end_key), end_key.size(), ",\"metric_end\":1e999");
-  CHECK_THROWS(jsa::fit_options_from_json(huge, "big"));
+  CHECK(jsa::fit_options_from_json(written(m, end_key), "old").metric_end == -1);
+  CHECK_THROWS(jsa::fit_options_from_json(written(m, end_key, ",\"metric_end\":1e999"), "big"));
   // ... and where it is reached (a later addition): kept, absent = the first
   // decay, out of (0, 1] refused.
   jsa::FitOptions u;
   u.metric_until = 0.2;
   CHECK(jsa::fit_options_from_json(jsa::fit_options_to_json(u), "x").metric_until == 0.2);
-  std::string before_until = jsa::fit_options_to_json(u, -1);
   const std::string until_key = ",\"metric_until\":0.2";
-  const auto until_at = before_until.find(until_key);
-  REQUIRE(until_at != std::string::npos);
-  before_until.erase(until_at, until_key.size());
-  CHECK(jsa::fit_options_from_json(before_until, "old").metric_until == -1);
-  for (const char* bad : {"0", "1.5", "1e999"}) {
-    std::string b = jsa::fit_options_to_json(u, -1);
-    b.replace(b.find(until_key), until_key.size(), std::string(",\"metric_until\":") + bad);
-    CHECK_THROWS(jsa::fit_options_from_json(b, "bad"));
-  }
+  CHECK(jsa::fit_options_from_json(written(u, until_key), "old").metric_until == -1);
+  for (const char* bad : {"0", "1.5", "1e999"})
+    CHECK_THROWS(jsa::fit_options_from_json(
+        written(u, until_key, std::string(",\"metric_until\":") + bad), "bad"));
   // The conformal L_metric (a later addition): kept, absent = isometric.
   jsa::FitOptions c;
   c.metric_conformal = true;
   CHECK(jsa::fit_options_from_json(jsa::fit_options_to_json(c), "x").metric_conformal);
-  std::string before_conf = jsa::fit_options_to_json(c, -1);
-  const std::string conf_key = ",\"metric_conformal\":true";
-  const auto conf_at = before_conf.find(conf_key);
-  REQUIRE(conf_at != std::string::npos);
-  before_conf.erase(conf_at, conf_key.size());
-  CHECK(!jsa::fit_options_from_json(before_conf, "old").metric_conformal);
+  CHECK(!jsa::fit_options_from_json(written(c, ",\"metric_conformal\":true"), "old")
+             .metric_conformal);
   // Later additions read as off when absent, and are kept when set: the pose
   // step's tie-break by fitting, and phi as a deformation per shape.
   jsa::FitOptions d;
@@ -206,26 +191,17 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   CHECK(read.pose_fit_steps == 300);
   CHECK(read.atlas.deform_layers == 3);
   for (const std::string key : {",\"pose_fit_steps\":300", ",\"deform_layers\":3"}) {
-    std::string before = jsa::fit_options_to_json(d, -1);
-    const auto at = before.find(key);
-    REQUIRE(at != std::string::npos);
-    before.erase(at, key.size());
-    const jsa::FitOptions old = jsa::fit_options_from_json(before, "old");
+    const jsa::FitOptions old = jsa::fit_options_from_json(written(d, key), "old");
     CHECK(old.pose_fit_steps == (key.find("pose") != std::string::npos ? 0 : 300));
     CHECK(old.atlas.deform_layers == (key.find("deform") != std::string::npos ? 0 : 3));
   }
-  std::string negative = jsa::fit_options_to_json(d, -1);
-  negative.replace(negative.find(",\"deform_layers\":3"), 18, ",\"deform_layers\":-1");
-  CHECK_THROWS(jsa::fit_options_from_json(negative, "negative"));
+  CHECK_THROWS(jsa::fit_options_from_json(
+      written(d, ",\"deform_layers\":3", ",\"deform_layers\":-1"), "negative"));
   // D reading the domain point: kept when set, off when absent.
   d.atlas.deform_domain = true;
   CHECK(jsa::fit_options_from_json(jsa::fit_options_to_json(d), "x").atlas.deform_domain);
-  std::string before_domain = jsa::fit_options_to_json(d, -1);
-  const std::string domain_key = ",\"deform_domain\":true";
-  const auto domain_at = before_domain.find(domain_key);
-  REQUIRE(domain_at != std::string::npos);
-  before_domain.erase(domain_at, domain_key.size());
-  CHECK(!jsa::fit_options_from_json(before_domain, "old").atlas.deform_domain);
+  CHECK(!jsa::fit_options_from_json(written(d, ",\"deform_domain\":true"), "old")
+             .atlas.deform_domain);
   // The node displacement and its registration: kept when set, off when absent.
   d.atlas.deform_nodes = 128;
   d.register_nodes = true;
@@ -255,12 +231,8 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
        {",\"deform_nodes\":128", ",\"register_nodes\":true", ",\"register_prior\":0.3",
         ",\"nodes_lr_scale\":0.5", ",\"nodes_width\":1.5", ",\"template_coverage\":true",
         ",\"fine_nodes\":64", ",\"fine_width\":0.5", ",\"chart_width\":96", ",\"chart_fourier\":16",
-        ",\"chart_fourier_sigma\":2.5"}) {
-    const auto at = before_nodes.find(key);
-    INFO(key);
-    REQUIRE(at != std::string::npos);
-    before_nodes.erase(at, key.size());
-  }
+        ",\"chart_fourier_sigma\":2.5"})
+    before_nodes = replaced(before_nodes, key);
   const jsa::FitOptions no_nodes = jsa::fit_options_from_json(before_nodes, "old");
   CHECK(no_nodes.atlas.deform_nodes == 0);
   CHECK(!no_nodes.register_nodes);
@@ -273,10 +245,8 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   CHECK(no_nodes.atlas.chart_width == 0);
   CHECK(no_nodes.atlas.chart_fourier == 0);
   CHECK(no_nodes.atlas.chart_fourier_sigma == jsa::AtlasOptions{}.chart_fourier_sigma);
-  std::string zero_width = jsa::fit_options_to_json(d, -1);
-  const std::string width_key = ",\"nodes_width\":1.5";
-  zero_width.replace(zero_width.find(width_key), width_key.size(), ",\"nodes_width\":0.0");
-  CHECK_THROWS(jsa::fit_options_from_json(zero_width, "zero width"));
+  CHECK_THROWS(jsa::fit_options_from_json(
+      written(d, ",\"nodes_width\":1.5", ",\"nodes_width\":0.0"), "zero width"));
   d.atlas.deform_nodes = 0;
   d.register_nodes = false;
   d.template_coverage = false;
@@ -295,11 +265,8 @@ TEST_CASE("fit config: settings added later read as what older runs did", "[fit_
   CHECK(kept.intrinsic == 0.25);
   CHECK(kept.intrinsic_until == 0.5);
   std::string before_intrinsic = jsa::fit_options_to_json(d, -1);
-  for (const std::string key : {",\"intrinsic\":0.25", ",\"intrinsic_until\":0.5"}) {
-    const auto at = before_intrinsic.find(key);
-    REQUIRE(at != std::string::npos);
-    before_intrinsic.erase(at, key.size());
-  }
+  for (const std::string key : {",\"intrinsic\":0.25", ",\"intrinsic_until\":0.5"})
+    before_intrinsic = replaced(before_intrinsic, key);
   const jsa::FitOptions absent = jsa::fit_options_from_json(before_intrinsic, "old");
   CHECK(absent.intrinsic == 0);
   CHECK(absent.intrinsic_until == 1);
