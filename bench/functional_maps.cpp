@@ -13,6 +13,7 @@
 //   bench_functional_maps --keypoints ../shared/data/shrec
 //       ../shared/data/shrec/ant_{1,2,3,4}.obj  [--k-end 60 --k-start 6 --k-step 2]
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -125,6 +126,55 @@ int main(int argc, char** argv) {
       for (size_t J = 0; J < n; ++J) std::printf(" %6.2f", 100 * e.pair_mean[I][J]);
     }
     std::printf("\n");
+  }
+  // What a map shows of itself without keypoints (issue 19: a start chosen per
+  // collection must be judged before any label is seen). Per rule, over the
+  // ordered pairs: the round trip T_JI(T_IJ(v)) against v, the triangle
+  // T_JK(T_IJ(v)) against T_IK(v), and I's edges torn (stretched more than 4x
+  // their length, or more than 0.1 of the unit radius) or collapsed (onto one
+  // vertex of J), every distance in the target's unit frame.
+  for (int rule = 0; rule < 2; ++rule) {
+    const auto& m = maps[size_t(rule)];
+    double trip = 0, triangle = 0, torn = 0, collapsed = 0;
+    int pairs = 0, triangles = 0;
+    for (size_t I = 0; I < n; ++I)
+      for (size_t J = 0; J < n; ++J) {
+        if (I == J) continue;
+        const Block<double>& xi = unit_vertices[I];
+        const Block<double>& xj = unit_vertices[J];
+        double s = 0;
+        for (Index v = 0; v < xi.rows(); ++v)
+          s += (xi.row(m[J][I][size_t(m[I][J][size_t(v)])]) - xi.row(v)).norm();
+        trip += s / double(xi.rows());
+        Index edges = 0, tears = 0, folds = 0;
+        for (Index f = 0; f < meshes[I].faces.rows(); ++f)
+          for (int c = 0; c < 3; ++c) {
+            const int a = meshes[I].faces(f, c), b = meshes[I].faces(f, (c + 1) % 3);
+            const double before = (xi.row(a) - xi.row(b)).norm();
+            const double after = (xj.row(m[I][J][size_t(a)]) - xj.row(m[I][J][size_t(b)])).norm();
+            ++edges;
+            if (after > std::max(4 * before, 0.1)) ++tears;
+            if (after == 0) ++folds;
+          }
+        torn += double(tears) / double(edges);
+        collapsed += double(folds) / double(edges);
+        ++pairs;
+        for (size_t K = 0; K < n; ++K) {
+          if (K == I || K == J) continue;
+          double t = 0;
+          for (Index v = 0; v < xi.rows(); ++v)
+            t += (unit_vertices[K].row(m[J][K][size_t(m[I][J][size_t(v)])]) -
+                  unit_vertices[K].row(m[I][K][size_t(v)]))
+                     .norm();
+          triangle += t / double(xi.rows());
+          ++triangles;
+        }
+      }
+    std::printf(
+        "%-18s label-free: round trip %.2f x 1e-2, triangle %.2f x 1e-2, edges torn %.2f%%, "
+        "collapsed %.1f%%\n",
+        names[rule], 100 * trip / pairs, triangles ? 100 * triangle / triangles : 0.0,
+        100 * torn / pairs, 100 * collapsed / pairs);
   }
   // The same through spectral_start (what `jsatlas fit --spectral-map` uses),
   // from each template t: t's keypoints carried to every other shape.

@@ -24,6 +24,7 @@
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -36,6 +37,7 @@
 #include "model/baselines/atlasnet.h"
 #include "model/tool/correspondence.h"
 #include "model/tool/evaluate.h"
+#include "model/tool/registration_check.h"
 #include "model/tool/shape_input.h"
 
 using namespace jsa;
@@ -63,7 +65,8 @@ struct Args {
 
 std::string row_name(int row) {
   if (row <= 4) return AtlasNetVariant::table_row(row).name();
-  if (row == kRecipeRow) return "jsatlas: row 11 + template start, D, L_metric, softplus";
+  if (row == kRecipeRow)
+    return "jsatlas: row 11 + template start, D, L_metric, softplus, registration if trusted";
   static const char* names[] = {"phi",
                                 "phi, n",
                                 "phi, n, L_rep",
@@ -85,6 +88,7 @@ json budget_json(const Args& a) {
   b["code_size"] = a.fit.atlas.code_size;
   b["lr"] = a.fit.lr;
   b["recipe_w_even"] = 0.0;  // row 12 as `jsatlas fit` collections (L_even on before 2026-12-05)
+  b["recipe_auto_register"] = kCollectionAutoRegister;  // and no registration before 2026-12-07
   b["pool"] = a.fit.pool;
   b["eval_samples"] = a.samples;
   b["inputs"] = a.inputs;
@@ -112,7 +116,8 @@ struct Category {
 // rows at the same budget: jsatlas's defaults (softplus, the orientation
 // mirror, the dense L_6D, L_metric), phi_i(x) = phi(x) + D(phi(x), f_i), and
 // the template start from the medoid, its 30% share counted in steps of equal
-// cost (Trainer::template_steps_for). The poses are the stored ones, as for
+// cost (Trainer::template_steps_for), and the registration as the start where
+// --auto-register trusts it (run_one). The poses are the stored ones, as for
 // the other rows (`jsatlas fit` would also align them).
 FitOptions recipe_options(const FitOptions& table, const std::vector<Block<double>>& pools) {
   FitOptions o;
@@ -133,6 +138,7 @@ FitOptions recipe_options(const FitOptions& table, const std::vector<Block<doubl
   o.template_share = 0.3;
   o.template_max_steps = kTemplateMaxSteps;
   o.template_shape = medoid_shape(pools).shape;
+  o.auto_register = kCollectionAutoRegister;
   return o;
 }
 
@@ -186,14 +192,27 @@ json run_one(const Args& a, const Category& cat, int row, int seed) {
         corr = keypoint_error(map, cat.meshes, frames, cat.keypoints);
       }
     } else {
+      std::optional<RegistrationCheck> check;
       if (row == kRecipeRow) {
         o = recipe_options(o, pools);
         j["template_shape"] = o.template_shape;
         j["template_steps"] = Trainer::template_steps_for(o, o.iterations, int(pools.size()));
+        // `jsatlas fit`'s --auto-register: the registration as the start where
+        // its maps invert each other (model/tool/registration_check.h).
+        check = check_registration(cat.meshes, frames, o.template_shape, o.auto_register);
+        j["registration_round_trip"] = {check->spectral, check->spatial};
+        j["registered"] = check->trusted;
+        if (check->trusted) {
+          o.atlas.deform_nodes = kAutoRegisterNodes;
+          o.register_nodes = true;
+          o.nodes_lr_scale = 0;
+        }
       } else {
         o.components = Components::table_row(row);
       }
       Trainer tr(o, pools);
+      if (check && check->trusted)
+        tr.set_spectral_map(check->start.template_vertices, check->start.images);
       while (!tr.finished()) {
         tr.step();
         progress(tr.iteration(), tr.last().total);
@@ -338,7 +357,10 @@ void write_table(const Args& a, const std::map<std::pair<int, int>, json>& runs,
        << ": `jsatlas fit`'s collection defaults at these sizes (softplus, orientation mirror, "
           "dense L_6D, L_metric, D of "
        << kCollectionDeformLayers << " layers), its template start (medoid, 30% share, at most "
-       << kTemplateMaxSteps << " steps) before the " << f.iterations << " joint iterations\n";
+       << kTemplateMaxSteps << " steps) before the " << f.iterations
+       << " joint iterations, from the spectral registration where its maps invert each other "
+          "(--auto-register "
+       << kCollectionAutoRegister << ")\n";
   md << "- Seeds: 1.." << a.seeds << "; runs done: " << runs.size() << " of "
      << a.rows.size() * size_t(a.seeds) << "\n";
   md << "- Evaluation: M' = " << a.samples

@@ -31,6 +31,7 @@
 #include "model/tool/gemm_choice.h"
 #include "model/tool/mpi/mpi_team.h"
 #include "model/tool/pose_by_fit.h"
+#include "model/tool/registration_check.h"
 #include "model/tool/shape_input.h"
 #include "model/tool/spectral_start.h"
 #include "model/tool/template_coverage.h"
@@ -69,6 +70,7 @@ struct FitArgs {
   bool emd_given = false;   // --w-emd
   bool lr_given = false;    // --lr
   bool points_given = false, gaussians_given = false, width_given = false, deform_given = false;
+  bool auto_register_given = false;  // --auto-register
 };
 
 std::string format_duration(double seconds) {
@@ -125,6 +127,7 @@ auto with_flag_names(F&& f) {
       {"register_prior", "--register-prior"},
       {"template_coverage", "--template-coverage"},
       {"nodes_lr_scale", "--nodes-lr-scale"},
+      {"auto_register", "--auto-register"},
       {"nodes_width", "--nodes-width"},
       {"atlas.deform_nodes", "--deform-nodes"},
       {"atlas.fine_nodes", "--fine-nodes"},
@@ -285,6 +288,7 @@ void run_fit(FitArgs& a, Team& team) {
       if (!a.gaussians_given) o.atlas.gaussians = kCollectionGaussians;
       if (!a.width_given) o.atlas.width = kCollectionWidth;
       if (!a.deform_given) o.atlas.deform_layers = kCollectionDeformLayers;
+      if (!a.auto_register_given) o.auto_register = kCollectionAutoRegister;
     }
     if (o.intrinsic > 0 && inputs.size() < 2)
       throw InputError("--intrinsic: needs a collection (two or more inputs)");
@@ -556,6 +560,56 @@ void run_fit(FitArgs& a, Team& team) {
         for (double v : m.sums) std::fprintf(stderr, " %.4g", v);
         std::cerr << "\n";
       }
+    }
+  }
+  // --auto-register (model/tool/registration_check.h): a collection of meshes
+  // for which neither nodes nor a registration were asked starts from the
+  // registration when its maps invert each other about as well as the
+  // nearest points in space do; the choice is kept in config.json as the
+  // options it sets, so a resumed run builds the same atlas.
+  // (A template the collection does not have is refused by the trainer.)
+  const bool may_register = !resuming && o.auto_register > 0 && inputs.size() > 1 &&
+                            o.atlas.deform_nodes == 0 && !o.register_nodes &&
+                            o.template_shape >= 0 && size_t(o.template_shape) < inputs.size();
+  if (may_register && many && !a.quiet)
+    std::cerr << "fit: no registration with " << team.size()
+              << " MPI ranks (--auto-register: one process only)\n";
+  if (may_register && !many) {
+    const auto s0 = std::chrono::steady_clock::now();
+    std::vector<Mesh> meshes;
+    for (const RunInput& s : shapes) meshes.push_back(s.mesh);
+    // A collection the maps cannot be made for (a point cloud, a mesh with
+    // fewer vertices than eigenfunctions) is fitted as before: the check is
+    // a choice of start, not a requirement of the run.
+    std::optional<RegistrationCheck> c;
+    std::string why_not;
+    try {
+      c = check_registration(meshes, frames, o.template_shape, o.auto_register,
+                             registration_options(o));
+    } catch (const InputError& e) {
+      why_not = e.what();
+    }
+    const double took =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();
+    pose_fit_seconds += took;  // counted against --minutes, as the pose step
+    if (c && c->trusted) {
+      o.atlas.deform_nodes = kAutoRegisterNodes;
+      o.register_nodes = true;
+      o.nodes_lr_scale = 0;
+      registration = std::move(c->start);
+    }
+    if (!a.quiet && !c) std::cerr << "fit: no registration (--auto-register: " << why_not << ")\n";
+    if (!a.quiet && c) {
+      std::fprintf(stderr,
+                   "fit: the template's spectral maps come back %.3g x 1e-2 off, the nearest "
+                   "points %.3g (%.2fx; trusted up to %.2gx, in %s): ",
+                   100 * c->spectral, 100 * c->spatial, c->spectral / std::max(c->spatial, 1e-12),
+                   o.auto_register, format_duration(took).c_str());
+      std::cerr << (c->trusted
+                        ? "registration as the start (--deform-nodes " +
+                              std::to_string(kAutoRegisterNodes) + " --register --nodes-lr-scale 0)"
+                        : std::string("no registration"))
+                << "\n";
     }
   }
   Trainer trainer = make_trainer(o, pools, &team);
@@ -1259,6 +1313,15 @@ void add_fit(CLI::App& app) {
               "Collections of meshes, with --deform-nodes: start each shape's node displacements "
               "from a spectral registration of the template to it (ZoomOut), fitted by least "
               "squares, so the maps decide the correspondence and the training refines it");
+  c->add_option("--auto-register", o.auto_register,
+                "Collections of meshes without --deform-nodes: start from the spectral "
+                "registration (as --deform-nodes " +
+                    std::to_string(kAutoRegisterNodes) +
+                    " --register --nodes-lr-scale 0) when the template's maps to the others "
+                    "and back come back at most this many times farther off than the nearest "
+                    "points in space do (collections: 2; 0: never)")
+      ->check(CLI::Range(0.0, 1e3))
+      ->check(kFinite);
   c->add_option("--nodes-lr-scale", o.nodes_lr_scale,
                 "With --deform-nodes: learning rate of the node displacements as a multiple of "
                 "the rest's (0: they keep the registration's start)")
@@ -1387,6 +1450,7 @@ void add_fit(CLI::App& app) {
     a->gaussians_given = c->count("--gaussians") > 0;
     a->width_given = c->count("--width") > 0;
     a->deform_given = c->count("--deform-layers") > 0;
+    a->auto_register_given = c->count("--auto-register") > 0;
     a->even_given = c->count("--w-even") > 0;
     a->emd_given = c->count("--w-emd") > 0;
     a->lr_given = c->count("--lr") > 0;

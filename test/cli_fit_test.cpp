@@ -536,3 +536,46 @@ TEST_CASE("cli: --template-coverage takes the template whose registration covers
   CHECK(r.output.find("spectral maps from the template (shape " + std::to_string(said_shape)) !=
         std::string::npos);
 }
+
+// --auto-register (model/tool/registration_check.h), on for collections of
+// meshes: the decision is printed with its figures, and what it decided is
+// what config.json keeps (the nodes a resumed run rebuilds); 0 asks nothing.
+TEST_CASE("cli: a collection of meshes decides on its registration and keeps the decision",
+          "[cli]") {
+  const std::string dir = fresh_dir("auto_register");
+  const std::string small =
+      " -K 200 -M 200 --width 16 --depth 2 --threads 1 --pool 5000 --mesh-resolution 24"
+      " --template-steps 3 --iters 2 --code-size 8 --checkpoint-every 0";
+  auto settings = [](const std::string& run) {
+    return nlohmann::json::parse(read_text(run + "/config.json"))["settings"];
+  };
+  Result r = run("fit builtin:capsule builtin:capsule -o " + dir + "/same" + small);
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  // Two copies of one mesh: every map comes back where it started, and the
+  // registration (the identity) is trusted.
+  CHECK(r.output.find("fit: the template's spectral maps come back 0 x 1e-2 off, the nearest "
+                      "points 0") != std::string::npos);
+  CHECK(r.output.find("registration as the start (--deform-nodes 256 --register "
+                      "--nodes-lr-scale 0)") != std::string::npos);
+  nlohmann::json s = settings(dir + "/same");
+  CHECK(s["auto_register"] == 2.0);
+  CHECK(s["atlas"]["deform_nodes"] == 256);
+  CHECK(s["register_nodes"] == true);
+  CHECK(s["nodes_lr_scale"] == 0.0);
+  // Asked for nothing: no check, no nodes.
+  r = run("fit builtin:capsule builtin:torus -o " + dir + "/never --auto-register 0" + small);
+  REQUIRE(r.code == 0);
+  CHECK(r.output.find("spectral maps come back") == std::string::npos);
+  s = settings(dir + "/never");
+  CHECK(s["atlas"]["deform_nodes"] == 0);
+  CHECK(s["register_nodes"] == false);
+  // Whatever a pair of different shapes decides, config.json says the same.
+  r = run("fit builtin:capsule builtin:torus -o " + dir + "/pair" + small);
+  REQUIRE(r.code == 0);
+  const bool trusted = r.output.find("registration as the start") != std::string::npos;
+  CHECK((trusted || r.output.find("): no registration") != std::string::npos));
+  s = settings(dir + "/pair");
+  CHECK(s["register_nodes"] == trusted);
+  CHECK(s["atlas"]["deform_nodes"] == (trusted ? 256 : 0));
+}

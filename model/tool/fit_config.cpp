@@ -117,6 +117,7 @@ std::string fit_options_to_json(const FitOptions& o, int indent) {
   j["register_nodes"] = o.register_nodes;
   j["register_prior"] = o.register_prior;
   j["nodes_lr_scale"] = o.nodes_lr_scale;
+  j["auto_register"] = o.auto_register;
   j["nodes_width"] = o.nodes_width;
   j["fine_width"] = o.fine_width;
   j["parallel_shapes"] = o.parallel_shapes;
@@ -293,6 +294,10 @@ FitOptions fit_options_from_json(const std::string& text, const std::string& wha
   if (j.contains("register_prior")) field(j, "", "register_prior", o.register_prior);
   if (!(o.register_prior >= 0) || !std::isfinite(o.register_prior))
     throw InputError(what + ": register_prior must be >= 0");
+  o.auto_register = 0;  // later addition: absent = never
+  if (j.contains("auto_register")) field(j, "", "auto_register", o.auto_register);
+  if (!(o.auto_register >= 0) || !std::isfinite(o.auto_register))
+    throw InputError(what + ": auto_register must be >= 0");
   o.nodes_lr_scale = 1;  // later addition: absent = one rate
   if (j.contains("nodes_lr_scale")) field(j, "", "nodes_lr_scale", o.nodes_lr_scale);
   if (!(o.nodes_lr_scale >= 0) || !std::isfinite(o.nodes_lr_scale))

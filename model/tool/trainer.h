@@ -185,6 +185,12 @@ struct FitOptions {
   // decide the correspondence and the training refines it. false: the nodes
   // start at zero.
   bool register_nodes = false;
+  // Collections of meshes with neither nodes nor --register asked for: take the
+  // registration anyway (256 nodes, held) when its maps invert each other at
+  // most this many times worse than the nearest points in space do
+  // (model/tool/registration_check.h; docs/collections.md, twenty-ninth round).
+  // 0: never. Decided by `jsatlas fit` before the trainer is built.
+  double auto_register = 0;
   // ... the maps' spatial prior (ZoomOutOptions::prior_weight, on ZoomOut's
   // sizes below 20): each template vertex is kept near where it is in space, so
   // an intrinsic symmetry (an ant's left and right legs) is settled by the
@@ -265,6 +271,7 @@ inline void apply_paper_method(FitOptions& o) {
   o.align_poses = false;  // and takes the shapes in the poses given
   o.pose_fit_steps = 0;
   o.atlas.deform_layers = 0;  // phi(x, f_i), the paper's conditioning
+  o.auto_register = 0;        // nor a registration
 }
 
 // lambda_metric at joint step i of a collection's run (FitOptions::metric_end,
@@ -314,6 +321,15 @@ constexpr int kCollectionWidth = 64;
 // closer, teddy level (10.44 -> 10.61), for 1.2-1.6x the step and about 110 MB
 // more for four shapes (docs/collections.md, ninth round).
 constexpr int kCollectionDeformLayers = 3;
+// ... and the registration as the start where its maps can be trusted
+// (FitOptions::auto_register): a round trip from the template through ZoomOut's
+// maps at most 2x the nearest points' (seeds 1-3: teddies 1.54-1.59x, ants
+// 2.34-2.68x; two families, so the line between them is a guess to be checked
+// on others; docs/collections.md, twenty-ninth round). What is then switched
+// on is the twentieth and twenty-first rounds' recipe for a folded part:
+// `--deform-nodes 256 --register --nodes-lr-scale 0`.
+constexpr double kCollectionAutoRegister = 2.0;
+constexpr int kAutoRegisterNodes = 256;
 // ... and a template start of at most this many steps (FitOptions::
 // template_max_steps). At the same 3000 joint steps (one thread, seed 1), a
 // template of 22000 steps against 9000 carries the ants worse (chart rule

@@ -30,10 +30,12 @@ printf 'builtin:sphere\nbuiltin:torus\nbuiltin:cube\nbuiltin:capsule\n' > shapes
 # others skip it (--no-align). No template start (refused on more than one rank; its automatic
 # length is 0 there) and shape 0 as L_metric's reference (the automatic medoid is
 # shape 0 there): the 1-process reference must train the same way. L_metric held
-# over all twelve steps (by default it ends at a quarter of the run).
+# over all twelve steps (by default it ends at a quarter of the run). No
+# registration (--auto-register: not over MPI yet, so not on the reference either).
 fit=(fit --list shapes.txt --iters 12 -M 64 -K 64 --width 16 --depth 2 --code-size 8 --pool 2000
      --threads 1 --orient-every 4 --mesh-resolution 8 --checkpoint-every 0 --seed 5 -q
-     --template-steps 0 --template-shape 0 --no-align --w-metric 1e-2 --w-metric-end -1)
+     --template-steps 0 --template-shape 0 --no-align --w-metric 1e-2 --w-metric-end -1
+     --auto-register 0)
 launch=("$mpiexec" --oversubscribe --bind-to none)
 [ "$(id -u)" -eq 0 ] && launch+=(--allow-run-as-root)
 run() {  # run NP ARGS...: one process without mpirun, else NP ranks

@@ -1,0 +1,63 @@
+#include "model/tool/registration_check.h"
+
+#include "engine/check.h"
+#include "io/geometry/nearest.h"
+
+namespace jsa {
+
+namespace {
+
+// Mean over t's vertices of |x_t(back(there(v))) - x_t(v)|.
+double round_trip(const Block<double>& x_t, const std::vector<int>& there,
+                  const std::vector<int>& back) {
+  double sum = 0;
+  for (Index v = 0; v < x_t.rows(); ++v)
+    sum += (x_t.row(back[size_t(there[size_t(v)])]) - x_t.row(v)).norm();
+  return sum / double(std::max<Index>(x_t.rows(), 1));
+}
+
+}  // namespace
+
+RegistrationCheck check_registration(const std::vector<Mesh>& meshes,
+                                     const std::vector<Normalization>& frames, int t, double ratio,
+                                     const SpectralStartOptions& o) {
+  const size_t n = meshes.size();
+  JSA_CHECK(n >= 2 && frames.size() == n && t >= 0 && size_t(t) < n,
+            "check_registration: two or more meshes, one frame each, and a template among them");
+  for (const Mesh& m : meshes)
+    if (m.is_point_cloud())
+      throw InputError("--auto-register needs triangle meshes (an input is a point cloud)");
+  std::vector<LaplaceBasis> bases;
+  for (const Mesh& m : meshes) bases.push_back(laplace_basis(m, o.functions));
+  RegistrationCheck c;
+  c.start = spectral_start(meshes, frames, t, o, &bases);
+  const Block<double>& x_t = c.start.template_vertices;
+  ZoomOutOptions zo;  // as spectral_start's, without the prior (it anchors on t)
+  zo.k_start = o.k_start;
+  zo.k_end = o.functions;
+  zo.k_step = o.k_step;
+  zo.samples = o.samples;
+  zo.orthogonal = true;
+  c.spectral_trip.assign(n, 0.0);
+  c.spatial_trip.assign(n, 0.0);
+  for (size_t i = 0; i < n; ++i) {
+    if (int(i) == t) continue;
+    const Block<double> x_i = frames[i].to_unit(meshes[i].vertices);
+    std::vector<int> there, back;
+    nearest(x_t, x_i, there);
+    nearest(x_i, x_t, back);
+    c.spatial_trip[i] = round_trip(x_t, there, back);
+    // T_ti as the registration has it (each template vertex's image is a
+    // vertex of i), T_it by ZoomOut on i's vertices from the nearest start.
+    std::vector<int> registered;
+    nearest(c.start.images[i], x_i, registered);
+    back = zoomout(bases[size_t(t)], bases[i], back, zo);
+    c.spectral_trip[i] = round_trip(x_t, registered, back);
+    c.spectral += c.spectral_trip[i] / double(n - 1);
+    c.spatial += c.spatial_trip[i] / double(n - 1);
+  }
+  c.trusted = c.spectral <= ratio * c.spatial;
+  return c;
+}
+
+}  // namespace jsa
