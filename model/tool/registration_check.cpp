@@ -32,12 +32,7 @@ RegistrationCheck check_registration(const std::vector<Mesh>& meshes,
   RegistrationCheck c;
   c.start = spectral_start(meshes, frames, t, o, &bases);
   const Block<double>& x_t = c.start.template_vertices;
-  ZoomOutOptions zo;  // as spectral_start's, without the prior (it anchors on t)
-  zo.k_start = o.k_start;
-  zo.k_end = o.functions;
-  zo.k_step = o.k_step;
-  zo.samples = o.samples;
-  zo.orthogonal = true;
+  const ZoomOutOptions zo = zoomout_options(o);  // without the prior (it anchors on t)
   c.spectral_trip.assign(n, 0.0);
   c.spatial_trip.assign(n, 0.0);
   for (size_t i = 0; i < n; ++i) {

@@ -5,6 +5,16 @@
 
 namespace jsa {
 
+ZoomOutOptions zoomout_options(const SpectralStartOptions& o) {
+  ZoomOutOptions zo;
+  zo.k_start = o.k_start;
+  zo.k_end = o.functions;
+  zo.k_step = o.k_step;
+  zo.samples = o.samples;
+  zo.orthogonal = true;
+  return zo;
+}
+
 SpectralStart spectral_start(const std::vector<Mesh>& meshes,
                              const std::vector<Normalization>& frames, int reference,
                              const SpectralStartOptions& o,
@@ -25,12 +35,7 @@ SpectralStart spectral_start(const std::vector<Mesh>& meshes,
     bases = &own;
   }
   const LaplaceBasis& on_t = (*bases)[size_t(reference)];
-  ZoomOutOptions zo;
-  zo.k_start = o.k_start;
-  zo.k_end = o.functions;
-  zo.k_step = o.k_step;
-  zo.samples = o.samples;
-  zo.orthogonal = true;
+  ZoomOutOptions zo = zoomout_options(o);
   out.images.resize(n);
   for (size_t i = 0; i < n; ++i) {
     if (int(i) == reference) continue;

@@ -24,6 +24,10 @@ struct SpectralStartOptions {
   int prior_until = 20;
 };
 
+// ZoomOut's settings for these sizes (orthogonal C, no prior: the prior is
+// anchored on a template and set where one is).
+ZoomOutOptions zoomout_options(const SpectralStartOptions& o);
+
 struct SpectralStart {
   Block<double> template_vertices;    // V_t x 3, the template's unit frame
   std::vector<Block<double>> images;  // per shape: V_t x 3 in its unit frame (t's own: empty)
