@@ -93,4 +93,7 @@ TEST_CASE("the registration check refuses a point cloud", "[tool][registration]"
   meshes[1].faces.resize(0, 3);
   const std::vector<jsa::Normalization> frames(2);
   CHECK_THROWS_AS(jsa::check_registration(meshes, frames, 0, 2.0), jsa::InputError);
+  // The message names the flag that asked for the spectra.
+  CHECK_THROWS_WITH(jsa::check_registration(meshes, frames, 0, 2.0),
+                    Catch::Contains("--auto-register needs triangle meshes"));
 }

@@ -84,4 +84,6 @@ TEST_CASE("the coverage choice refuses a point cloud", "[tool][template_coverage
   const std::vector<jsa::Normalization> frames(2);
   std::vector<Block<double>> pools(2, Block<double>::Random(100, 3));
   CHECK_THROWS_AS(jsa::template_by_coverage(meshes, frames, pools), jsa::InputError);
+  CHECK_THROWS_WITH(jsa::template_by_coverage(meshes, frames, pools),
+                    Catch::Contains("--template-coverage needs triangle meshes"));
 }

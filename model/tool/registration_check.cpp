@@ -24,11 +24,7 @@ RegistrationCheck check_registration(const std::vector<Mesh>& meshes,
   const size_t n = meshes.size();
   JSA_CHECK(n >= 2 && frames.size() == n && t >= 0 && size_t(t) < n,
             "check_registration: two or more meshes, one frame each, and a template among them");
-  for (const Mesh& m : meshes)
-    if (m.is_point_cloud())
-      throw InputError("--auto-register needs triangle meshes (an input is a point cloud)");
-  std::vector<LaplaceBasis> bases;
-  for (const Mesh& m : meshes) bases.push_back(laplace_basis(m, o.functions));
+  const std::vector<LaplaceBasis> bases = laplace_bases(meshes, o.functions, "--auto-register");
   RegistrationCheck c;
   c.start = spectral_start(meshes, frames, t, o, &bases);
   const Block<double>& x_t = c.start.template_vertices;

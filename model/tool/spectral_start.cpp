@@ -15,6 +15,16 @@ ZoomOutOptions zoomout_options(const SpectralStartOptions& o) {
   return zo;
 }
 
+std::vector<LaplaceBasis> laplace_bases(const std::vector<Mesh>& meshes, int functions,
+                                        const std::string& option) {
+  for (const Mesh& m : meshes)
+    if (m.is_point_cloud())
+      throw InputError(option + " needs triangle meshes (an input is a point cloud)");
+  std::vector<LaplaceBasis> bases;
+  for (const Mesh& m : meshes) bases.push_back(laplace_basis(m, functions));
+  return bases;
+}
+
 SpectralStart spectral_start(const std::vector<Mesh>& meshes,
                              const std::vector<Normalization>& frames, int reference,
                              const SpectralStartOptions& o,
@@ -23,17 +33,14 @@ SpectralStart spectral_start(const std::vector<Mesh>& meshes,
   JSA_CHECK(frames.size() == n && reference >= 0 && size_t(reference) < n,
             "spectral_start: one frame per mesh, and a reference among them");
   JSA_CHECK(!bases || bases->size() == n, "spectral_start: one basis per mesh");
-  for (const Mesh& m : meshes)
-    if (m.is_point_cloud())
-      throw InputError("--spectral-map needs triangle meshes (an input is a point cloud)");
+  std::vector<LaplaceBasis> own;
+  if (!bases) {
+    own = laplace_bases(meshes, o.functions, "--spectral-map");
+    bases = &own;
+  }
   SpectralStart out;
   const Mesh& t = meshes[size_t(reference)];
   out.template_vertices = frames[size_t(reference)].to_unit(t.vertices);
-  std::vector<LaplaceBasis> own;
-  if (!bases) {
-    for (const Mesh& m : meshes) own.push_back(laplace_basis(m, o.functions));
-    bases = &own;
-  }
   const LaplaceBasis& on_t = (*bases)[size_t(reference)];
   ZoomOutOptions zo = zoomout_options(o);
   out.images.resize(n);

@@ -6,6 +6,7 @@
 // agrees on which end is the head and which side is left; the eigenfunctions
 // then decide the rest whatever the pose of an arm.
 #pragma once
+#include <string>
 #include <vector>
 
 #include "io/geometry/functional_map.h"
@@ -33,10 +34,16 @@ struct SpectralStart {
   std::vector<Block<double>> images;  // per shape: V_t x 3 in its unit frame (t's own: empty)
 };
 
+// Each mesh's Laplace-Beltrami basis of `functions` eigenfunctions, for the
+// tools that map a collection by its spectra. Throws InputError naming
+// `option` when an input is a point cloud (it has no Laplacian).
+std::vector<LaplaceBasis> laplace_bases(const std::vector<Mesh>& meshes, int functions,
+                                        const std::string& option);
+
 // meshes in their input frames, frames the unit frames of the fit (with the
-// pose step's rotations). Throws InputError for a point cloud. bases: each
-// mesh's laplace_basis(mesh, o.functions), when the caller has them already
-// (nullptr: computed here).
+// pose step's rotations). bases: laplace_bases(meshes, o.functions, ...), when
+// the caller has them already (nullptr: computed here, and a point cloud
+// refused as --spectral-map's input).
 SpectralStart spectral_start(const std::vector<Mesh>& meshes,
                              const std::vector<Normalization>& frames, int reference,
                              const SpectralStartOptions& o = {},

@@ -33,11 +33,7 @@ CoverageChoice template_by_coverage(const std::vector<Mesh>& meshes,
   const size_t n = meshes.size();
   JSA_CHECK(n >= 1 && frames.size() == n && pools.size() == n,
             "template_by_coverage: one frame and one pool per mesh");
-  for (const Mesh& m : meshes)
-    if (m.is_point_cloud())
-      throw InputError("--template-coverage needs triangle meshes (an input is a point cloud)");
-  std::vector<LaplaceBasis> bases;
-  for (const Mesh& m : meshes) bases.push_back(laplace_basis(m, o.functions));
+  const std::vector<LaplaceBasis> bases = laplace_bases(meshes, o.functions, "--template-coverage");
   CoverageChoice c;
   c.sums.assign(n, 0.0);
   for (size_t t = 0; t < n; ++t) {
