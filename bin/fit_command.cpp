@@ -71,6 +71,7 @@ struct FitArgs {
   bool lr_given = false;    // --lr
   bool points_given = false, gaussians_given = false, width_given = false, deform_given = false;
   bool auto_register_given = false;  // --auto-register
+  bool chart_fourier_given = false;  // --chart-fourier
 };
 
 std::string format_duration(double seconds) {
@@ -289,6 +290,7 @@ void run_fit(FitArgs& a, Team& team) {
       if (!a.width_given) o.atlas.width = kCollectionWidth;
       if (!a.deform_given) o.atlas.deform_layers = kCollectionDeformLayers;
       if (!a.auto_register_given) o.auto_register = kCollectionAutoRegister;
+      if (!a.chart_fourier_given) o.atlas.chart_fourier = kCollectionChartFourier;
     }
     if (o.intrinsic > 0 && inputs.size() < 2)
       throw InputError("--intrinsic: needs a collection (two or more inputs)");
@@ -1099,7 +1101,10 @@ void add_fit(CLI::App& app) {
       ->check(CLI::Range(0, 4096));
   c->add_option("--chart-fourier", o.atlas.chart_fourier,
                 "psi's input widened by this many random Fourier features of the point, "
-                "[p, alpha n, sin(p B), cos(p B)] (0: the paper's psi); beyond the paper")
+                "[p, alpha n, sin(p B), cos(p B)] (collections: " +
+                    std::to_string(kCollectionChartFourier) +
+                    "; 0: the paper's psi, the default for a single shape and --preset paper); "
+                    "beyond the paper")
       ->capture_default_str()
       ->check(CLI::Range(0, 4096));
   c->add_option("--chart-fourier-sigma", o.atlas.chart_fourier_sigma,
@@ -1451,6 +1456,7 @@ void add_fit(CLI::App& app) {
     a->width_given = c->count("--width") > 0;
     a->deform_given = c->count("--deform-layers") > 0;
     a->auto_register_given = c->count("--auto-register") > 0;
+    a->chart_fourier_given = c->count("--chart-fourier") > 0;
     a->even_given = c->count("--w-even") > 0;
     a->emd_given = c->count("--w-emd") > 0;
     a->lr_given = c->count("--lr") > 0;

@@ -368,6 +368,10 @@ TEST_CASE("cli: the schedule's flags are saved, collections keep M fixed, a shor
   CHECK(settings(dir + "_pair")["iterations"] == 5000);
   CHECK(settings(dir + "_pair")["weights"]["evenness"] == 0);  // L_even: single shapes only
   CHECK(settings(dir + "_pair")["lr"] == jsa::kCollectionLearningRate);  // 1e-3
+  // psi on Fourier features: collections only (the paper's psi for one shape).
+  CHECK(settings(dir + "_pair")["atlas"]["chart_fourier"] == jsa::kCollectionChartFourier);
+  CHECK(jsa::kCollectionChartFourier > 0);
+  CHECK(single["atlas"]["chart_fourier"] == 0);
   r = run("fit builtin:sphere builtin:torus -o " + dir +
           "_pair_ramp --stop-at 1 --template-steps 0 --no-align --schedule ramp --iters 30" +
           kSmall);
@@ -375,9 +379,11 @@ TEST_CASE("cli: the schedule's flags are saved, collections keep M fixed, a shor
   CHECK(settings(dir + "_pair_ramp")["schedule"]["kind"] == "ramp");
   CHECK(settings(dir + "_pair_ramp")["iterations"] == 30);
   r = run("fit builtin:sphere builtin:torus -o " + dir +
-          "_pair_lr --stop-at 1 --template-steps 0 --no-align --lr 5e-3" + kSmall);
+          "_pair_lr --stop-at 1 --template-steps 0 --no-align --lr 5e-3 --chart-fourier 0" +
+          kSmall);
   REQUIRE(r.code == 0);
-  CHECK(settings(dir + "_pair_lr")["lr"] == 5e-3);  // a given rate is kept
+  CHECK(settings(dir + "_pair_lr")["lr"] == 5e-3);                   // a given rate is kept
+  CHECK(settings(dir + "_pair_lr")["atlas"]["chart_fourier"] == 0);  // and a given psi
   CHECK(run("fit builtin:sphere -o " + dir + "_bad --schedule cosine" + kSmall).code == 2);
   CHECK(run("fit builtin:sphere -o " + dir + "_bad --points-start 0" + kSmall).code == 2);
   CHECK(run("fit builtin:sphere -o " + dir + "_bad --ramp-levels 0" + kSmall).code == 2);

@@ -330,6 +330,14 @@ constexpr int kCollectionDeformLayers = 3;
 // `--deform-nodes 256 --register --nodes-lr-scale 0`.
 constexpr double kCollectionAutoRegister = 2.0;
 constexpr int kAutoRegisterNodes = 256;
+// ... and psi on 32 random Fourier features of the point (AtlasOptions::
+// chart_fourier, sigma 4): on today's default, one run each, alone on two
+// cores, chart rule x 1e-2, the ants at ten minutes over seeds 1-3 4.33
+// against 4.97 and at five 4.73 against 5.11, the teddies at ten over seeds
+// 1-2 7.44 against 7.82 and at five 7.75 against 8.17, every reconstruction
+// inside the goals at ten minutes; 1.03-1.05x a joint step and
+// 1.1-1.2x a template step (docs/collections.md, thirtieth round).
+constexpr int kCollectionChartFourier = 32;
 // ... and a template start of at most this many steps (FitOptions::
 // template_max_steps). At the same 3000 joint steps (one thread, seed 1), a
 // template of 22000 steps against 9000 carries the ants worse (chart rule
