@@ -334,9 +334,10 @@ constexpr int kAutoRegisterNodes = 256;
 // chart_fourier, sigma 4): on today's default, one run each, alone on two
 // cores, chart rule x 1e-2, the ants at ten minutes over seeds 1-3 4.33
 // against 4.97 and at five 4.73 against 5.11, the teddies at ten over seeds
-// 1-2 7.44 against 7.82 and at five 7.75 against 8.17, every reconstruction
-// inside the goals at ten minutes; 1.03-1.05x a joint step and
-// 1.1-1.2x a template step (docs/collections.md, thirtieth round).
+// 1-2 7.44 against 7.82 and at five 7.75 against 8.17, and the ants at
+// thirty 3.73 against 3.97, every ant's surface inside the goals at
+// ten and thirty minutes; 1.03x a joint step, 1.1-1.2x a template step (one
+// run each; docs/collections.md, thirtieth round).
 constexpr int kCollectionChartFourier = 32;
 // ... and a template start of at most this many steps (FitOptions::
 // template_max_steps). At the same 3000 joint steps (one thread, seed 1), a
