@@ -89,6 +89,7 @@ json budget_json(const Args& a) {
   b["lr"] = a.fit.lr;
   b["recipe_w_even"] = 0.0;  // row 12 as `jsatlas fit` collections (L_even on before 2026-12-05)
   b["recipe_auto_register"] = kCollectionAutoRegister;  // and no registration before 2026-12-07
+  b["recipe_chart_fourier"] = kCollectionChartFourier;  // and the paper's psi before 2026-12-07, late
   b["pool"] = a.fit.pool;
   b["eval_samples"] = a.samples;
   b["inputs"] = a.inputs;
@@ -114,7 +115,8 @@ struct Category {
 // Row 12: what `jsatlas fit A B C D` trains, at this table's sizes and length,
 // so that the recipe of docs/collections.md is measured next to the paper's
 // rows at the same budget: jsatlas's defaults (softplus, the orientation
-// mirror, the dense L_6D, L_metric), phi_i(x) = phi(x) + D(phi(x), f_i), and
+// mirror, the dense L_6D, L_metric), phi_i(x) = phi(x) + D(phi(x), f_i), psi
+// on random Fourier features (kCollectionChartFourier), and
 // the template start from the medoid, its 30% share counted in steps of equal
 // cost (Trainer::template_steps_for), and the registration as the start where
 // --auto-register trusts it (run_one). The poses are the stored ones, as for
@@ -139,6 +141,7 @@ FitOptions recipe_options(const FitOptions& table, const std::vector<Block<doubl
   o.template_max_steps = kTemplateMaxSteps;
   o.template_shape = medoid_shape(pools).shape;
   o.auto_register = kCollectionAutoRegister;
+  o.atlas.chart_fourier = kCollectionChartFourier;  // psi on Fourier features of its 6D input
   return o;
 }
 
