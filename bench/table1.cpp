@@ -89,7 +89,7 @@ json budget_json(const Args& a) {
   b["lr"] = a.fit.lr;
   b["recipe_w_even"] = 0.0;  // row 12 as `jsatlas fit` collections (L_even on before 2026-12-05)
   b["recipe_auto_register"] = kCollectionAutoRegister;  // and no registration before 2026-12-07
-  b["recipe_chart_fourier"] = kCollectionChartFourier;  // and the paper's psi before 2026-12-07, late
+  b["recipe_chart_fourier"] = kCollectionChartFourier;  // the paper's psi before 2026-12-07
   b["pool"] = a.fit.pool;
   b["eval_samples"] = a.samples;
   b["inputs"] = a.inputs;
