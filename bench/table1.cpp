@@ -66,7 +66,8 @@ struct Args {
 std::string row_name(int row) {
   if (row <= 4) return AtlasNetVariant::table_row(row).name();
   if (row == kRecipeRow)
-    return "jsatlas: row 11 + template start, D, L_metric, softplus, registration if trusted";
+    return "jsatlas: row 11 + template start, D, L_metric, softplus, registration if trusted, psi "
+           "on Fourier features";
   static const char* names[] = {"phi",
                                 "phi, n",
                                 "phi, n, L_rep",
