@@ -336,8 +336,11 @@ constexpr int kAutoRegisterNodes = 256;
 // against 4.97 and at five 4.73 against 5.11, the teddies at ten over seeds
 // 1-2 7.44 against 7.82 and at five 7.75 against 8.17, and the ants at
 // thirty 3.73 against 3.97, every ant's surface inside the goals at
-// ten and thirty minutes; 1.03x a joint step, 1.1-1.2x a template step (one
-// run each; docs/collections.md, thirtieth round).
+// ten and thirty minutes; 1.06x a joint step (median of three alternated
+// fits), 1.1-1.2x a template step (docs/collections.md, thirtieth round). At
+// thirty minutes the teddies are level on the chart rule (7.33 against 7.33,
+// nearest 7.00 against 7.47) and fit worse (normals up to 1.62x the floor
+// against 1.46x): the one measurement against it (thirty-first round).
 constexpr int kCollectionChartFourier = 32;
 // ... and a template start of at most this many steps (FitOptions::
 // template_max_steps). At the same 3000 joint steps (one thread, seed 1), a
