@@ -340,7 +340,9 @@ constexpr int kAutoRegisterNodes = 256;
 // fits), 1.1-1.2x a template step (docs/collections.md, thirtieth round). At
 // thirty minutes the teddies are level on the chart rule (7.33 against 7.33,
 // nearest 7.00 against 7.47) and fit worse (normals up to 1.62x the floor
-// against 1.46x): the one measurement against it (thirty-first round).
+// against 1.46x), and eight ants at five minutes carry keypoints worse (9.92
+// against 8.54 over seeds 1-2): the measurements against it (thirty-first
+// round).
 constexpr int kCollectionChartFourier = 32;
 // ... and a template start of at most this many steps (FitOptions::
 // template_max_steps). At the same 3000 joint steps (one thread, seed 1), a
