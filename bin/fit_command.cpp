@@ -553,7 +553,15 @@ void run_fit(FitArgs& a, Team& team) {
         for (double v : c.sums) std::fprintf(stderr, " %.4g", v);
         std::cerr << "\n";
       }
-    } else if (!many && inputs.size() > 1) {
+    } else if (!many && inputs.size() == 2) {
+      // Two shapes have no medoid (each Chamfer sum is the other's). The
+      // coverage as the tie-break was measured and lost on the ants
+      // (docs/collections.md, thirty-second round): the first stays.
+      if (!a.quiet)
+        std::cerr << "fit: template shape 0 (" << inputs[0]
+                  << "), the first of two (two shapes have no medoid; --template-shape 1 takes "
+                     "the other)\n";
+    } else if (!many && inputs.size() > 2) {
       const MedoidChoice m = medoid_shape(pools);
       o.template_shape = m.shape;
       if (!a.quiet) {
@@ -1392,9 +1400,10 @@ void add_fit(CLI::App& app) {
        "codes copied to every shape (-1: from --template-share)")
       ->capture_default_str()
       ->check(CLI::Range(int64_t(-1), int64_t(100000000)));
-  c->add_option("--template-shape", o.template_shape,
-                "Collections: the shape the template start fits and copies, and L_metric's "
-                "reference (-1: the medoid, the shape closest to all others)")
+  c->add_option(
+       "--template-shape", o.template_shape,
+       "Collections: the shape the template start fits and copies, and L_metric's "
+       "reference (-1: the medoid, the shape closest to all others; of two shapes, the first)")
       ->capture_default_str()
       ->check(CLI::Range(-1, 1 << 20));
   c->add_option("--template-share", o.template_share,

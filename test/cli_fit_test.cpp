@@ -583,6 +583,9 @@ TEST_CASE("cli: a collection of meshes decides on its registration and keeps the
   // Whatever a pair of different shapes decides, config.json says the same.
   r = run("fit builtin:capsule builtin:torus -o " + dir + "/pair" + small);
   REQUIRE(r.code == 0);
+  // Two shapes have no medoid: the first is the template, and the run says so.
+  CHECK(r.output.find("fit: template shape 0 (builtin:capsule), the first of two") !=
+        std::string::npos);
   const bool trusted = r.output.find("registration as the start") != std::string::npos;
   CHECK((trusted || r.output.find("): no registration") != std::string::npos));
   s = settings(dir + "/pair");
